@@ -1,0 +1,44 @@
+#pragma once
+/// What the detector says about one frame.
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace sg::core {
+
+enum class Severity { kNone, kWarning, kDanger };
+enum class Steering { kStraight, kLeft, kRight, kStop };
+
+/// "none" / "warning" / "danger".
+const char* to_string(Severity s);
+/// "straight" / "left" / "right" / "stop".
+const char* to_string(Steering s);
+
+struct RegionSignal {
+  std::string name;       ///< "left", "centre", "right" for the default three columns
+  bool fired = false;     ///< after hysteresis
+  int dangerous_px = 0;   ///< dangerous pixels in this region in this frame (before hysteresis)
+};
+
+struct Obstacle {
+  cv::Rect bbox;                       ///< in left-image pixels
+  int pixels = 0;                      ///< dangerous pixels of the blob
+  double distance_m = 0.0;             ///< median depth of the blob, m
+  std::optional<double> ttc_s;         ///< median time to contact, s
+  std::optional<cv::Vec3d> velocity;   ///< mean 3D velocity relative to the camera, m/s (Stereo-Flow)
+};
+
+struct Detection {
+  int frame = 0;
+  double time_s = 0.0;
+  bool signal = false;                  ///< any region fired
+  Severity severity = Severity::kNone;  ///< by the smallest obstacle TTC, none when no signal
+  Steering steering = Steering::kStraight;
+  std::vector<RegionSignal> regions;
+  std::vector<Obstacle> obstacles;
+  double latency_ms = 0.0;              ///< acquisition to detection, ms
+  cv::Mat danger;                       ///< CV_8U mask after clean-up, 255 = dangerous (for overlays)
+};
+
+}  // namespace sg::core

@@ -1,0 +1,31 @@
+#pragma once
+/// Overlay video: the left image, danger pixels tinted red, obstacle boxes labelled with distance
+/// and TTC, region signals along the top, severity and steering hint.
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "sg/core/detection.hpp"
+#include "sg/core/frame.hpp"
+
+namespace sg::io {
+
+/// Draws the overlay of one frame (BGR, size of the left image).
+cv::Mat draw_overlay(const core::StereoFrame& frame, const core::Detection& detection);
+
+class OverlayWriter {
+ public:
+  /// Opens an MP4 (mp4v) video; throws core::InputError when it cannot be created.
+  OverlayWriter(const std::filesystem::path& path, cv::Size size, double fps);
+  void write(const core::StereoFrame& frame, const core::Detection& detection);
+  int frames_written() const { return frames_; }
+  /// Finalises the file (also done by the destructor).
+  void close();
+
+ private:
+  cv::VideoWriter writer_;
+  std::filesystem::path path_;
+  int frames_ = 0;
+};
+
+}  // namespace sg::io

@@ -1,0 +1,67 @@
+#pragma once
+/// The stereo folder (README "Stereo folder"): DIR/camera.yaml, DIR/left/*.png, DIR/right/*.png
+/// (sorted by name, equal counts and sizes), optional DIR/gt/ (frames.jsonl, disp/, flow/,
+/// danger/, ids/ with files NNNNNN.png / NNNNNN.flo).
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sg/core/camera.hpp"
+#include "sg/core/ground_truth.hpp"
+#include "sg/core/source.hpp"
+
+namespace sg::io {
+
+/// Reads camera.yaml (focal_px, baseline_m, cx, cy, fps). width/height are left as given in
+/// `size` (taken from the images). Throws core::InputError naming the file and the field.
+core::Camera read_camera_yaml(const std::filesystem::path& path, cv::Size size);
+void write_camera_yaml(const std::filesystem::path& path, const core::Camera& camera);
+
+/// Reads a stereo folder lazily. The constructor checks the layout (folder, camera.yaml, equal
+/// left/right counts, at least one frame, first pair readable and of equal size); next() checks each
+/// pair (decodable, same size as the first). Every problem is a core::InputError naming the file.
+class FolderSource : public core::FrameSource {
+ public:
+  explicit FolderSource(const std::filesystem::path& dir);
+  std::optional<core::StereoFrame> next() override;
+  const core::Camera& camera() const override { return camera_; }
+  int size() const override { return static_cast<int>(left_.size()); }
+
+  bool has_truth() const;
+  /// gt/frames.jsonl entry of frame i; throws InputError when absent or malformed.
+  const core::FrameTruth& truth(int index) const;
+  /// gt maps of frame i that exist on disk (others left empty).
+  core::TruthMaps truth_maps(int index) const;
+
+ private:
+  std::filesystem::path dir_;
+  core::Camera camera_;
+  std::vector<std::filesystem::path> left_, right_;
+  std::vector<core::FrameTruth> truth_;
+  int next_index_ = 0;
+};
+
+/// Writes a stereo folder frame by frame (used by `simulate`). Files are written as frames arrive;
+/// gt/frames.jsonl gets one complete line per frame.
+class FolderWriter {
+ public:
+  FolderWriter(const std::filesystem::path& dir, const core::Camera& camera, bool with_truth);
+  void write(const core::StereoFrame& frame, const core::FrameTruth* truth = nullptr,
+             const core::TruthMaps* maps = nullptr);
+  int frames_written() const { return frames_; }
+
+ private:
+  std::filesystem::path dir_;
+  bool with_truth_;
+  int frames_ = 0;
+};
+
+/// File name of frame i in a stereo folder: zero-padded to 6 digits + extension (".png").
+std::string frame_file_name(int index, const char* extension);
+
+/// Parses one gt/frames.jsonl line; throws InputError naming `where` when malformed.
+core::FrameTruth parse_truth_line(const std::string& line, const std::string& where);
+std::string truth_to_json_line(const core::FrameTruth& truth);
+
+}  // namespace sg::io

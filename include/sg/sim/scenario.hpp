@@ -1,0 +1,54 @@
+#pragma once
+/// Scenarios for the simulator (DESIGN 4): a camera, a textured ground and background, and boxes.
+/// World frame = the camera frame at t = 0 (x right, y down, z forward, metres); the camera moves
+/// with ego_velocity; the ground is the plane Y = height_m.
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "sg/core/camera.hpp"
+#include "sg/core/params.hpp"
+
+namespace sg::sim {
+
+struct Box {
+  int id = 1;                          ///< >= 1, unique; written to the ids map
+  cv::Vec3d size_m{1.0, 1.5, 0.5};     ///< width (X), height (Y), depth (Z), m
+  cv::Vec3d position_m{0, 0, 15};      ///< centre at t = 0, world frame, m
+  cv::Vec3d velocity_mps{0, 0, 0};     ///< constant, world frame, m/s
+  std::uint32_t texture_seed = 1;      ///< texture fixed to the box
+};
+
+struct Scenario {
+  std::string name;
+  std::string description;
+  core::Camera camera;                    ///< 640x480, f 500 px, B 0.12 m, 30 fps by default
+  double height_m = 1.2;                  ///< camera height above the ground, m
+  cv::Vec3d ego_velocity_mps{0, 0, 0};    ///< camera velocity, world frame, m/s
+  int frames = 150;                       ///< frames to render
+  double background_z_m = 40.0;           ///< textured wall facing the camera at this depth, m
+  std::uint32_t ground_seed = 11;         ///< ground texture
+  std::uint32_t background_seed = 12;     ///< background texture
+  double noise_sigma = 1.0;               ///< Gaussian pixel noise, gray levels (0 = none)
+  double right_gain = 1.0;                ///< brightness gain of the right camera (photometric mismatch)
+  std::uint32_t noise_seed = 7;           ///< noise is a fixed function of (seed, frame, side)
+  std::vector<Box> obstacles;
+  core::Envelope envelope;                ///< for the ground-truth collision test
+  int min_area_px = 150;                  ///< GT alarm: a colliding obstacle covers at least this
+};
+
+/// Names of the built-in scenarios (head-on, crossing, receding, static, ego-wall, ego-pass,
+/// two-obstacles, ...).
+std::vector<std::string> builtin_scenario_names();
+/// A built-in scenario; throws core::InputError naming the known ones for an unknown name.
+Scenario builtin_scenario(const std::string& name);
+/// A scenario from a YAML (or JSON) file; unspecified fields keep the defaults above.
+/// Throws core::InputError naming the file and the bad field.
+Scenario load_scenario_file(const std::string& path);
+/// A built-in name, or else a path to a scenario file.
+Scenario resolve_scenario(const std::string& name_or_path);
+/// Every violation as text; empty when valid.
+std::vector<std::string> validate(const Scenario& s);
+
+}  // namespace sg::sim

@@ -1,0 +1,50 @@
+#pragma once
+/// From dangerous pixels to signals (DESIGN 3.3): clean-up, obstacles, regions, hysteresis,
+/// severity, steering hint.
+#include <deque>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "sg/core/camera.hpp"
+#include "sg/core/detection.hpp"
+#include "sg/core/params.hpp"
+
+namespace sg::vision {
+
+/// Opening with an open_size square, then connected components (8-connected); blobs smaller than
+/// min_area_px are removed from `mask` (in place). Returns one Obstacle per kept blob, in
+/// raster order of their first pixel: bbox, pixels, median depth of valid disparities, median TTC
+/// of finite ttc values. disp: CV_32F (invalid < 0); ttc: CV_32F (NaN = none).
+std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp,
+                                              const cv::Mat& ttc, const core::Camera& camera,
+                                              const core::SignalParams& p);
+
+/// Names of `columns` regions: {"left", "centre", "right"} for 3, else "r0", "r1", ...
+std::vector<std::string> region_names(int columns);
+
+/// Dangerous pixels in each of `columns` equal-width columns of the mask.
+std::vector<int> count_region_pixels(const cv::Mat& mask, int columns);
+
+/// Per-region hysteresis: a region turns on after on_k of the last on_n frames were dangerous
+/// (count > region_min_px) and off after off_m consecutive clear frames.
+class RegionHysteresis {
+ public:
+  explicit RegionHysteresis(const core::SignalParams& p);
+  std::vector<core::RegionSignal> update(const std::vector<int>& region_pixels);
+
+ private:
+  core::SignalParams p_;
+  std::vector<std::deque<bool>> history_;
+  std::vector<int> clear_run_;
+  std::vector<bool> on_;
+};
+
+/// none / warning / danger by the smallest obstacle TTC; none when `signal` is false.
+core::Severity severity_of(bool signal, const std::vector<core::Obstacle>& obstacles,
+                           const core::SignalParams& p);
+
+/// Straight when the centre is clear; otherwise the clear side with the fewest dangerous pixels
+/// (left on ties); stop when every region fired.
+core::Steering steering_hint(const std::vector<core::RegionSignal>& regions);
+
+}  // namespace sg::vision

@@ -1,0 +1,67 @@
+#include <gtest/gtest.h>
+
+#include "sg/core/error.hpp"
+#include "sg/core/params.hpp"
+
+namespace sg::core {
+namespace {
+
+bool mentions(const std::vector<std::string>& problems, const std::string& text) {
+  for (const auto& p : problems)
+    if (p.find(text) != std::string::npos) return true;
+  return false;
+}
+
+TEST(Params, DefaultsAreValid) {
+  EXPECT_TRUE(validate(DetectorParams{}, Camera{}).empty());
+}
+
+TEST(Params, EvenBlockSizeIsRejected) {
+  DetectorParams p;
+  p.bm.block_size = 10;
+  EXPECT_TRUE(mentions(validate(p, Camera{}), "stereo.block_size=10"));
+}
+
+TEST(Params, NumDisparitiesMustBePositiveMultipleOf16) {
+  for (int n : {0, -16, 70}) {
+    DetectorParams p;
+    p.bm.num_disparities = n;
+    EXPECT_TRUE(mentions(validate(p, Camera{}), "stereo.num_disparities=" + std::to_string(n)))
+        << n;
+  }
+}
+
+TEST(Params, NumDisparitiesMustFitTheImage) {
+  DetectorParams p;
+  p.bm.num_disparities = 640;
+  EXPECT_TRUE(mentions(validate(p, Camera{}), "below the image width"));
+}
+
+TEST(Params, HysteresisAndSeverityRules) {
+  SignalParams s;
+  s.on_k = 4;
+  s.on_n = 3;
+  s.ttc_warning_s = 1.0;
+  const auto problems = validate(s);
+  EXPECT_TRUE(mentions(problems, "signal.on_k=4"));
+  EXPECT_TRUE(mentions(problems, "signal.ttc_warning_s=1"));
+}
+
+TEST(Params, ThrowIfInvalidJoinsProblems) {
+  EXPECT_NO_THROW(throw_if_invalid({}, "ctx"));
+  try {
+    throw_if_invalid({"a", "b"}, "invalid parameters");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "invalid parameters: a; b");
+  }
+}
+
+TEST(Params, ParseMode) {
+  EXPECT_EQ(parse_mode("stereo"), Mode::kStereo);
+  EXPECT_EQ(parse_mode("stereo-flow"), Mode::kStereoFlow);
+  EXPECT_THROW(parse_mode("mono"), InputError);
+}
+
+}  // namespace
+}  // namespace sg::core
