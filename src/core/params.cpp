@@ -73,6 +73,8 @@ std::vector<std::string> validate(const StereoLabelParams& p) {
   for (int k : p.gaps) c.require(k >= 1 && k <= 60, "gaps", k, "each gap must be in 1..60");
   c.require(finite_positive(p.z_max_m), "z_max_m", p.z_max_m, "must be > 0");
   c.require(finite_positive(p.min_delta_d_px), "min_delta_d_px", p.min_delta_d_px, "must be > 0");
+  c.require(p.max_growth == 0.0 || (std::isfinite(p.max_growth) && p.max_growth > 1.0),
+            "max_growth", p.max_growth, "must be 0 (off) or > 1");
   return out;
 }
 

@@ -39,10 +39,19 @@ struct Envelope {
 /// Stereo-mode pixel labelling (DESIGN 3.1): depth decreases.
 struct StereoLabelParams {
   /// Frame gaps k compared: D_i against D_{i-k}. k = 1 is the thesis; larger k catch slow
-  /// (far) approaches whose per-frame disparity change is below the matcher's noise.
-  std::vector<int> gaps = {1, 4, 10};
+  /// (far) approaches whose per-frame disparity change is below the matcher's noise. At 30 fps
+  /// gap 15 spans 0.5 s: a point with TTC <= 3 s at Z m changes by >= f*B*0.5/(3 Z) px over it
+  /// (1 px at 10 m for f*B = 60), so min_delta_d_px = 1 still sees it (simulated head-on:
+  /// recall 1.0, lead 2.98 s; static and receding scenes: no alarm frame).
+  std::vector<int> gaps = {1, 5, 15};
   double z_max_m = 12.0;        ///< ignore points farther than this, m
-  double min_delta_d_px = 0.5;  ///< D_i - D_{i-k} must reach this, px
+  /// D_i - D_{i-k} must reach this, px. Well above BM's sub-pixel noise (0.1-0.3 px): with 0.5 the
+  /// simulated receding box raised alarms.
+  double min_delta_d_px = 1.0;
+  /// D_i <= max_growth * D_{i-k}, else the gap is ignored for that pixel: a depth that more than
+  /// halves within the gap is an object edge sweeping over the pixel, not motion (an approach that
+  /// fast is caught by the smaller gaps). 0 disables; otherwise > 1.
+  double max_growth = 2.0;
   /// Skip points outside the envelope's vertical band (ground, overhead): y_top <= Y <= y_bottom.
   bool use_envelope_band = true;
 };

@@ -13,11 +13,26 @@ struct RenderedFrame {
   core::FrameTruth truth;
 };
 
+/// Ground-truth collision test of one box at time t_s (DESIGN 4), relative to the moving camera
+/// with constant relative velocity V = velocity - ego_velocity: with Z_near the depth of the box's
+/// nearest face, t_c = (Z_near - z_contact) / (-V_z) when V_z < 0; the box collides when
+/// 0 < t_c <= horizon and at t_c its X extent overlaps [-half_width, half_width] and its Y extent
+/// overlaps [y_top, y_bottom]. A box already at the contact depth (Z_near <= z_contact, Z_far >= 0)
+/// that overlaps the envelope now collides with TTC 0. ttc_s is set only when colliding.
+core::ObstacleTruth box_collision(const Scenario& s, const Box& box, double t_s);
+
 /// Pure function of (scenario, frame index): rendering frame i never depends on other frames.
+/// Pixel (x, y) looks along ((x - cx) / f, (y - cy) / f, 1); the left camera sits at
+/// ego_velocity * t, the right one baseline_m further along +X. Rows are rendered with
+/// cv::parallel_for_; the output does not depend on the thread count.
 class Renderer {
  public:
+  /// Throws core::InputError when validate(scenario) finds problems.
   explicit Renderer(Scenario scenario);
+  /// Images and ground truth of frame `index` (0 <= index < frames), t = index / fps.
   RenderedFrame render(int index) const;
+  /// Only the FrameTruth of frame `index` (ray casting without shading; several times faster).
+  core::FrameTruth truth(int index) const;
   const Scenario& scenario() const { return scenario_; }
 
  private:

@@ -28,6 +28,8 @@ struct Scenario {
   cv::Vec3d ego_velocity_mps{0, 0, 0};    ///< camera velocity, world frame, m/s
   int frames = 150;                       ///< frames to render
   double background_z_m = 40.0;           ///< textured wall facing the camera at this depth, m
+  /// Height of that wall above the ground, m; rays passing above it see a uniform sky (disparity 0).
+  double background_height_m = 15.0;
   std::uint32_t ground_seed = 11;         ///< ground texture
   std::uint32_t background_seed = 12;     ///< background texture
   double noise_sigma = 1.0;               ///< Gaussian pixel noise, gray levels (0 = none)
@@ -46,8 +48,13 @@ Scenario builtin_scenario(const std::string& name);
 /// A scenario from a YAML (or JSON) file; unspecified fields keep the defaults above.
 /// Throws core::InputError naming the file and the bad field.
 Scenario load_scenario_file(const std::string& path);
-/// A built-in name, or else a path to a scenario file.
+/// A built-in name, or else a path to a scenario file; throws core::InputError listing the
+/// built-ins when it is neither.
 Scenario resolve_scenario(const std::string& name_or_path);
+/// The scenario as YAML text with every field, readable by load_scenario_file.
+std::string to_yaml(const Scenario& s);
+/// Writes to_yaml(s) to `path`; throws core::InputError when the file cannot be written.
+void save_scenario_file(const Scenario& s, const std::string& path);
 /// Every violation as text; empty when valid.
 std::vector<std::string> validate(const Scenario& s);
 

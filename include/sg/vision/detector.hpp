@@ -20,9 +20,14 @@ struct FrameMaps {
 
 class Detector {
  public:
-  /// params must be valid (core::validate).
+  /// params must be valid (core::validate). Throws core::InputError for Mode::kStereoFlow (not
+  /// implemented yet).
   Detector(const core::DetectorParams& params, const core::Camera& camera);
-  /// Frames must arrive in order. The first frame (no history) is never dangerous.
+  /// Frames must arrive in order. Labels D_i against the past maps of every configured gap k for
+  /// which k frames of history exist (so the first frame is never dangerous), then obstacles,
+  /// region counts, hysteresis, severity and steering. Fills frame and time_s from `frame`,
+  /// danger = the cleaned mask; leaves latency_ms to the caller. Throws core::InputError when the
+  /// disparity is not a non-empty CV_32F map or changes size within the stream.
   core::Detection process(const core::StereoFrame& frame, const FrameMaps& maps);
 
  private:
@@ -32,7 +37,8 @@ class Detector {
   RegionHysteresis hysteresis_;
 };
 
-/// Computes the disparity for a frame with the configured matcher (whole image).
+/// Computes the disparity for a frame with the configured matcher (whole image: match_bm).
+/// Throws core::InputError when left/right are not CV_8UC1 of the same size.
 void compute_disparity(const core::StereoFrame& frame, const core::DetectorParams& params,
                        cv::Mat& disp);
 

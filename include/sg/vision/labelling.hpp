@@ -14,11 +14,16 @@ struct PastDisparity {
   const cv::Mat* disp;   ///< CV_32F, invalid < 0
 };
 
-/// Stereo mode: p is dangerous for gap k when D_i(p) and D_{i-k}(p) are valid, Z_i(p) <= z_max,
-/// D_i - D_{i-k} >= min_delta_d_px, TTC = k*dt * D_{i-k} / (D_i - D_{i-k}) <= horizon, and (when
-/// use_envelope_band) the point's Y lies in the envelope's band. A pixel dangerous for any gap
-/// is dangerous; its TTC is the smallest over the gaps that flag it.
-/// danger: CV_8U 0/255; ttc: CV_32F seconds, NaN where safe.
+/// Stereo mode: p is dangerous for gap k when D_i(p) and D_{i-k}(p) are valid (> 0: a zero
+/// disparity is a point at infinity), Z_i(p) <= z_max, D_i - D_{i-k} >= min_delta_d_px,
+/// D_i <= max_growth * D_{i-k} (when max_growth > 0),
+/// its time to contact TTC = k*dt * D_{i-k} / (D_i - D_{i-k}) * (Z_i - z_contact) / Z_i (the time
+/// to reach the envelope's contact depth, dt = 1/fps) <= envelope.horizon_s, and (when
+/// use_envelope_band) the point's Y = (y - cy) * Z_i / f lies in [y_top_m, y_bottom_m]. A pixel
+/// dangerous for any gap is dangerous; its TTC is that of the longest gap that flags it (for a
+/// constant approach every gap estimates the same TTC; the longest averages the most noise).
+/// `past` may be empty (nothing is dangerous); every past map has the size of `disp`.
+/// danger: CV_8U 0/255; ttc: CV_32F seconds, NaN where safe (both allocated if needed).
 void label_stereo(const cv::Mat& disp, const std::vector<PastDisparity>& past,
                   const core::Camera& camera, const core::StereoLabelParams& p,
                   const core::Envelope& envelope, cv::Mat& danger, cv::Mat& ttc);

@@ -1,0 +1,114 @@
+#pragma once
+/// Stereo-Flow labelling (DESIGN 3.2): the 3D motion of each pixel, from the current disparity, the
+/// backward flow and a past disparity, heads into the safety envelope or not.
+#include <cstdint>
+#include <limits>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "sg/core/camera.hpp"
+#include "sg/core/params.hpp"
+
+namespace sg::vision {
+
+struct SceneFlowParams {
+  /// Frame gaps k compared by label_stereo_flow_window: P_i against P_{i-k} along the chained
+  /// flow. k = 1 is the thesis; larger k see slow (far) approaches whose per-frame disparity
+  /// change is below the matcher's noise. Gaps beyond the history given are skipped.
+  std::vector<int> gaps = {1, 4, 10};
+  double v_min_mps = 0.3;  ///< approach speed the point must reach, -V_z >= v_min, m/s
+  double z_max_m = 12.0;   ///< ignore points farther than this, m
+  /// The disparity must have grown by this much over the gap, D_i(p) - D_{i-k}(q) >= this, px:
+  /// a noise gate, as in Stereo mode; 0 disables it.
+  double min_delta_d_px = 0.5;
+  /// Velocities faster than this are mismatches and are ignored, m/s.
+  double max_speed_mps = 40.0;
+  /// The past disparity D_{i-k}(q) is unknown when the neighbours its bilinear sample uses differ
+  /// by more than this, px: at a depth edge the mix of object and background would look like a
+  /// fast approach. Infinity disables the check.
+  double max_disparity_step_px = 1.0;
+};
+
+/// Every violation as "scene_flow.<field>=<value>: <rule>"; empty when valid.
+std::vector<std::string> validate(const SceneFlowParams& p);
+
+/// Bilinear sample of a CV_32F disparity map (invalid < 0) at (x, y), px. Neighbours with zero
+/// weight are not used (so integer coordinates read one pixel, and x = w-1 is inside). False when
+/// (x, y) is outside [0, w-1] x [0, h-1] or not finite, when a neighbour used is invalid, or when
+/// the neighbours used differ by more than max_step px (a depth edge). `out` is untouched on false.
+bool sample_disparity_bilinear(const cv::Mat& disp, float x, float y, float& out,
+                               float max_step = std::numeric_limits<float>::infinity());
+
+/// Bilinear sample of a CV_32FC2 flow at (x, y), px, same rules as sample_disparity_bilinear
+/// (a neighbour with a non-finite component is invalid).
+bool sample_flow_bilinear(const cv::Mat& flow, float x, float y, cv::Vec2f& out);
+
+/// 3D velocity relative to the camera, m/s, of the point seen at p with disparity d_cur now and
+/// at q with disparity d_prev `dt` seconds earlier: V = (P(p, d_cur) - P(q, d_prev)) / dt.
+/// position = P(p, d_cur), m. False (outputs untouched) when a disparity is <= 0 or dt <= 0.
+bool point_velocity(cv::Point2f p, float d_cur, cv::Point2f q, float d_prev,
+                    const core::Camera& camera, double dt, cv::Vec3d& velocity,
+                    cv::Point3d& position);
+
+/// DESIGN 3.2: the point P moving at V (m, m/s) approaches (V_z <= -v_min) and at
+/// t_c = (P_z - z_contact) / (-V_z), with 0 < t_c <= horizon, lies inside the envelope:
+/// |X(t_c)| <= half_width, y_top <= Y(t_c) <= y_bottom. t_contact = t_c, s, when true.
+bool heads_into_envelope(const cv::Point3d& P, const cv::Vec3d& V, const core::Envelope& e,
+                         double v_min, double& t_contact);
+
+/// Gap-1 Stereo-Flow labelling of frame i. disp_cur = D_i, disp_prev = D_{i-1} (CV_32F, invalid
+/// < 0), flow = B_i (CV_32FC2 backward flow i -> i-1), all the same size; dt = frame period, s.
+/// p is dangerous when D_i(p) > 0, q = p + B_i(p) samples D_{i-1}(q) > 0 bilinearly (with
+/// max_disparity_step_px), Z_i <= z_max,
+/// D_i(p) - D_{i-1}(q) >= min_delta_d_px, |V| <= max_speed and heads_into_envelope. p.gaps is not
+/// used. Outputs (allocated): danger CV_8U 0/255; ttc CV_32F s, NaN where safe; velocity
+/// CV_32FC3 m/s, NaN where it cannot be computed (it is filled beyond z_max too).
+void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const cv::Mat& flow,
+                       const core::Camera& cam, const core::Envelope& env,
+                       const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
+                       cv::Mat& velocity);
+
+/// Stereo-Flow labelling over several frame gaps (p.gaps). past_disps[j] = D_{i-1-j} and
+/// past_flows[j] = B_{i-j} (newest first: past_flows[0] is the current frame's flow). For gap k
+/// the point is followed back along the chained flow q_0 = p, q_{m+1} = q_m + B_{i-m}(q_m)
+/// (bilinear) to q_k, and V = (P_i(p) - P_{i-k}(q_k, D_{i-k}(q_k))) / (k dt); the test is that of
+/// label_stereo_flow. A gap needs k past disparities and k flows; longer gaps are skipped. A pixel
+/// flagged by any gap is dangerous; its TTC is the smallest over the flagging gaps and its velocity
+/// that of the gap giving it; a safe pixel's velocity comes from the largest gap that gives one.
+void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const cv::Mat*>& past_disps,
+                              const std::vector<const cv::Mat*>& past_flows,
+                              const core::Camera& cam, const core::Envelope& env,
+                              const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
+                              cv::Mat& velocity);
+
+/// A plane n . P + c = 0 in camera coordinates (|n| = 1, n pointing up, i.e. n_y < 0).
+struct GroundPlane {
+  cv::Vec3d normal{0.0, -1.0, 0.0};
+  double offset = 0.0;  ///< c, m
+  int inliers = 0;      ///< sample points within the tolerance
+  bool found = false;
+};
+
+struct GroundParams {
+  double lower_fraction = 0.4;  ///< fit on the bottom fraction of the image rows, (0, 1]
+  int sample_step_px = 4;       ///< sample every n-th row and column, >= 1
+  int iterations = 200;         ///< RANSAC iterations, >= 1
+  double tolerance_m = 0.05;    ///< inlier distance to the plane, m
+  double z_max_m = 12.0;        ///< ignore points farther than this, m
+  int min_inliers = 200;        ///< fewer inliers: no plane found
+  std::uint64_t seed = 12345;   ///< fixed RANSAC seed (reproducible)
+};
+
+/// Fits the ground plane to the valid 3D points of the lower image by RANSAC (3-point samples,
+/// then a least-squares refit to the inliers). Planes steeper than 45 degrees from horizontal
+/// are rejected (walls). disp: CV_32F, invalid < 0.
+GroundPlane fit_ground_plane(const cv::Mat& disp, const core::Camera& cam, const GroundParams& p);
+
+/// 255 where the pixel's 3D point lies within `tolerance_m` of the plane or below it (under the
+/// ground), 0 elsewhere and where the disparity is invalid. Clear `danger` with it to exclude the
+/// ground when the camera is tilted. mask: CV_8U, allocated.
+void mark_ground(const cv::Mat& disp, const core::Camera& cam, const GroundPlane& plane,
+                 double tolerance_m, cv::Mat& mask);
+
+}  // namespace sg::vision

@@ -1,0 +1,36 @@
+// stereoguard: warns when something is about to hit a stereo camera. See README.md.
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "commands.hpp"
+#include "sg/core/error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"stereoguard: obstacle warnings from a stereo camera"};
+  app.require_subcommand(0, 1);
+  sg::apps::add_run_command(app);
+  sg::apps::add_simulate_command(app);
+  sg::apps::add_eval_command(app);
+  try {
+    if (argc == 1) {
+      // No arguments: the main job on its built-in scenario.
+      const char* run_args[] = {argv[0], "run"};
+      app.parse(2, run_args);
+    } else {
+      app.parse(argc, argv);
+    }
+    if (app.get_subcommands().empty()) throw CLI::CallForHelp();
+  } catch (const CLI::Success& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  } catch (const sg::core::InputError& e) {
+    std::cerr << "stereoguard: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "stereoguard: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,61 @@
+#include "options.hpp"
+
+#include "sg/core/error.hpp"
+#include "sg/io/config.hpp"
+#include "sg/io/stereo_folder.hpp"
+
+namespace sg::apps {
+
+void add_input_options(CLI::App& app, InputOptions& options) {
+  auto* scenario = app.add_option("--scenario", options.scenario,
+                                  "built-in scenario name or scenario YAML file");
+  auto* input = app.add_option("--input", options.input, "stereo folder (see README)");
+  scenario->excludes(input);
+}
+
+OpenedInput open_input(const InputOptions& options) {
+  OpenedInput opened;
+  if (!options.input.empty()) {
+    opened.name = options.input;
+    auto source = std::make_unique<io::FolderSource>(options.input);
+    opened.folder = source.get();
+    opened.source = std::move(source);
+    return opened;
+  }
+  std::string name = options.scenario.empty() ? options.fallback_scenario : options.scenario;
+  if (name.empty()) throw core::InputError("give --scenario NAME|FILE or --input DIR");
+  auto source = std::make_unique<sim::ScenarioSource>(sim::resolve_scenario(name));
+  opened.name = name;
+  opened.scenario = source.get();
+  opened.source = std::move(source);
+  return opened;
+}
+
+void add_detector_options(CLI::App& app, DetectorOptions& o) {
+  app.add_option("--config", o.config, "YAML config file (flags given too override it)");
+  app.add_option("--mode", o.mode, "stereo (default) or stereo-flow");
+  app.add_option("--num-disparities", o.num_disparities,
+                 "stereo search range, px (positive multiple of 16; default 64)");
+  app.add_option("--block-size", o.block_size, "stereo block size, px (odd, 5..255)");
+  app.add_option("--gaps", o.gaps,
+                 "frame gaps k compared in Stereo mode, e.g. --gaps 1 (the thesis) or 1,4,10")
+      ->delimiter(',');
+  app.add_option("--min-area", o.min_area, "smallest obstacle blob, px (default 150)");
+  app.add_option("--fps", o.fps, "pace the input like a camera at this rate, Hz (0 = no pacing)");
+}
+
+pipeline::RunOptions make_run_options(const DetectorOptions& o) {
+  pipeline::RunOptions run;
+  io::RunSettings settings;
+  if (!o.config.empty()) io::apply_config_file(o.config, run.params, settings);
+  run.pace_fps = settings.pace_fps;
+  if (o.mode) run.params.mode = core::parse_mode(*o.mode);
+  if (o.num_disparities) run.params.bm.num_disparities = *o.num_disparities;
+  if (o.block_size) run.params.bm.block_size = *o.block_size;
+  if (o.gaps) run.params.stereo.gaps = *o.gaps;
+  if (o.min_area) run.params.signal.min_area_px = *o.min_area;
+  if (o.fps) run.pace_fps = *o.fps;
+  return run;
+}
+
+}  // namespace sg::apps

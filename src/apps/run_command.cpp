@@ -1,0 +1,133 @@
+// `stereoguard run`: the main job. Detects obstacles on a scenario or a stereo folder, writes
+// events, an overlay video and a summary.
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <optional>
+
+#include "commands.hpp"
+#include "options.hpp"
+#include "sg/core/error.hpp"
+#include "sg/io/events.hpp"
+#include "sg/io/overlay.hpp"
+
+namespace sg::apps {
+namespace {
+
+struct RunArgs {
+  InputOptions input{.scenario = {}, .input = {}, .fallback_scenario = "head-on"};
+  DetectorOptions detector;
+  std::string events, overlay, summary;
+  bool no_timing = false;
+  bool quiet = false;
+};
+
+/// One line when the warning state changes, so a user sees the warnings as they happen.
+class WarningPrinter {
+ public:
+  void operator()(const core::Detection& d) {
+    // Severity may flicker with the TTC estimate: say only when it rises.
+    const bool changed = d.signal != last_signal_ || d.steering != last_steering_ ||
+                         (d.signal && d.severity > last_severity_);
+    last_signal_ = d.signal;
+    last_severity_ = d.severity;
+    last_steering_ = d.steering;
+    if (!changed) return;
+    std::cout << "frame " << std::setw(4) << d.frame << "  t=" << std::fixed
+              << std::setprecision(2) << d.time_s << " s  ";
+    if (!d.signal) {
+      std::cout << "clear\n";
+      return;
+    }
+    std::cout << (d.severity == core::Severity::kDanger ? "DANGER " : "WARNING") << "  regions";
+    for (const auto& r : d.regions)
+      if (r.fired) std::cout << " " << r.name;
+    const core::Obstacle* nearest = nullptr;
+    for (const auto& o : d.obstacles)
+      if (!nearest || o.distance_m < nearest->distance_m) nearest = &o;
+    if (nearest) {
+      std::cout << std::setprecision(1) << "  nearest " << nearest->distance_m << " m";
+      if (nearest->ttc_s) std::cout << ", TTC " << *nearest->ttc_s << " s";
+    }
+    std::cout << "  steer " << core::to_string(d.steering) << "\n";
+  }
+
+ private:
+  bool last_signal_ = false;
+  core::Severity last_severity_ = core::Severity::kNone;
+  core::Steering last_steering_ = core::Steering::kStraight;
+};
+
+void run_main(const RunArgs& args) {
+  const pipeline::RunOptions options = make_run_options(args.detector);
+  OpenedInput in = open_input(args.input);
+  const core::Camera& cam = in.source->camera();
+  core::throw_if_invalid(pipeline::validate(options, cam), "invalid parameters");
+
+  std::string overlay = args.overlay;
+  if (overlay.empty() && args.input.input.empty() && args.input.scenario.empty()) {
+    overlay = "stereoguard-" + in.name + ".mp4";
+  }
+  std::optional<io::EventWriter> events;
+  if (!args.events.empty()) events.emplace(args.events, !args.no_timing);
+  // The video is written under a temporary name and renamed only when the run succeeds, so a
+  // failed run never leaves a truncated video that looks complete.
+  const std::string overlay_partial = overlay + ".partial.mp4";
+  std::optional<io::OverlayWriter> video;
+  if (!overlay.empty()) video.emplace(overlay_partial, cv::Size(cam.width, cam.height), cam.fps);
+
+  std::cout << "stereoguard run: " << in.name << ", " << cam.width << "x" << cam.height << ", "
+            << (in.source->size() >= 0 ? std::to_string(in.source->size()) + " frames, " : "")
+            << "mode " << core::to_string(options.params.mode) << "\n";
+  WarningPrinter printer;
+  pipeline::RunSummary summary;
+  try {
+    summary = pipeline::run(*in.source, options,
+                            [&](const core::StereoFrame& frame, const core::Detection& d) {
+                              if (events) events->write(d);
+                              if (video) video->write(frame, d);
+                              if (!args.quiet) printer(d);
+                            });
+  } catch (...) {
+    if (video) {
+      video->close();
+      std::filesystem::remove(overlay_partial);
+    }
+    throw;
+  }
+  std::cout << "\n" << summary.text();
+  if (video) {
+    video->close();
+    std::filesystem::rename(overlay_partial, overlay);
+    std::cout << "overlay           " << overlay << " (" << video->frames_written()
+              << " frames)\n";
+  }
+  if (events) std::cout << "events            " << args.events << "\n";
+  if (!args.summary.empty()) {
+    std::ofstream out(args.summary);
+    if (!out) throw core::InputError("cannot write summary file " + args.summary);
+    out << summary.to_json().dump(2) << "\n";
+    std::cout << "summary           " << args.summary << "\n";
+  }
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app) {
+  auto args = std::make_shared<RunArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "run", "detect obstacles on a scenario or a stereo folder (default: the head-on scenario)");
+  add_input_options(*cmd, args->input);
+  add_detector_options(*cmd, args->detector);
+  cmd->add_option("--events", args->events, "write one JSON line per frame to this file");
+  cmd->add_option("--overlay", args->overlay,
+                  "write an overlay video (.mp4); default with no input: stereoguard-head-on.mp4");
+  cmd->add_option("--summary", args->summary, "write the run summary as JSON");
+  cmd->add_flag("--no-timing", args->no_timing,
+                "leave latency_ms out of the events (byte-identical repeated runs)");
+  cmd->add_flag("--quiet", args->quiet, "do not print warnings as they happen");
+  cmd->callback([args] { run_main(*args); });
+}
+
+}  // namespace sg::apps

@@ -1,0 +1,121 @@
+#include "sg/io/config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <map>
+#include <string>
+
+#include "sg/core/error.hpp"
+
+namespace sg::io {
+namespace {
+
+/// Reads the keys of one YAML map into fields; unknown keys are errors.
+class Section {
+ public:
+  Section(const YAML::Node& node, std::string where) : node_(node), where_(std::move(where)) {
+    if (node_ && !node_.IsMap()) fail(where_, "must be a map");
+  }
+  template <typename T>
+  Section& field(const char* key, T& out) {
+    known_[key] = true;
+    if (const YAML::Node v = node_[key]) {
+      try {
+        out = v.as<T>();
+      } catch (const YAML::Exception&) {
+        fail(where_ + "." + key, "has the wrong type");
+      }
+    }
+    return *this;
+  }
+  /// Marks `key` as a sub-section read by its own Section.
+  Section& section(const char* key) {
+    known_[key] = true;
+    return *this;
+  }
+  void done() const {
+    if (!node_) return;
+    for (const auto& kv : node_) {
+      const std::string key = kv.first.as<std::string>();
+      if (!known_.count(key)) fail(where_ + "." + key, "is not a known setting");
+    }
+  }
+  [[noreturn]] static void fail(const std::string& key, const std::string& rule) {
+    throw core::InputError(key + " " + rule);
+  }
+
+ private:
+  YAML::Node node_;
+  std::string where_;
+  std::map<std::string, bool> known_;
+};
+
+}  // namespace
+
+void apply_config_file(const std::filesystem::path& path, core::DetectorParams& p,
+                       RunSettings& settings) {
+  const std::string file = path.string();
+  if (!std::filesystem::is_regular_file(path)) {
+    throw core::InputError("config file " + file + " does not exist");
+  }
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file);
+  } catch (const YAML::Exception& e) {
+    throw core::InputError("config file " + file + ": " + e.what());
+  }
+  if (!root || root.IsNull()) return;
+  try {
+    if (!root.IsMap()) Section::fail("top level", "must be a map");
+    std::string mode = core::to_string(p.mode);
+    Section(root, "config")
+        .field("mode", mode)
+        .field("fps", settings.pace_fps)
+        .section("stereo")
+        .section("label")
+        .section("envelope")
+        .section("signal")
+        .done();
+    p.mode = core::parse_mode(mode);
+    Section(root["stereo"], "stereo")
+        .field("min_disparity", p.bm.min_disparity)
+        .field("num_disparities", p.bm.num_disparities)
+        .field("block_size", p.bm.block_size)
+        .field("prefilter_cap", p.bm.prefilter_cap)
+        .field("texture_threshold", p.bm.texture_threshold)
+        .field("uniqueness_ratio", p.bm.uniqueness_ratio)
+        .field("speckle_window", p.bm.speckle_window)
+        .field("speckle_range", p.bm.speckle_range)
+        .field("lr_max_diff", p.bm.lr_max_diff)
+        .done();
+    Section(root["label"], "label")
+        .field("gaps", p.stereo.gaps)
+        .field("z_max_m", p.stereo.z_max_m)
+        .field("min_delta_d_px", p.stereo.min_delta_d_px)
+        .field("use_envelope_band", p.stereo.use_envelope_band)
+        .done();
+    Section(root["envelope"], "envelope")
+        .field("half_width_m", p.envelope.half_width_m)
+        .field("y_top_m", p.envelope.y_top_m)
+        .field("y_bottom_m", p.envelope.y_bottom_m)
+        .field("z_contact_m", p.envelope.z_contact_m)
+        .field("horizon_s", p.envelope.horizon_s)
+        .done();
+    Section(root["signal"], "signal")
+        .field("open_size", p.signal.open_size)
+        .field("min_area_px", p.signal.min_area_px)
+        .field("region_columns", p.signal.region_columns)
+        .field("region_min_px", p.signal.region_min_px)
+        .field("on_k", p.signal.on_k)
+        .field("on_n", p.signal.on_n)
+        .field("off_m", p.signal.off_m)
+        .field("ttc_danger_s", p.signal.ttc_danger_s)
+        .field("ttc_warning_s", p.signal.ttc_warning_s)
+        .done();
+  } catch (const core::InputError& e) {
+    throw core::InputError("config file " + file + ": " + e.what());
+  }
+}
+
+}  // namespace sg::io

@@ -1,0 +1,147 @@
+// Built-in scenarios (DESIGN 4). All use the default camera (640x480, f 500 px, B 0.12 m, 30 fps,
+// 1.2 m above the ground) and the default envelope (|X| <= 0.5 m, -1 <= Y <= 1 m, contact at
+// Z = 0.5 m, horizon 3 s). Boxes stand on the ground unless noted. Contact times in the comments
+// follow box_collision(): t_c = (Z_near - 0.5) / (-V_z).
+#include <functional>
+#include <utility>
+
+#include "sg/core/error.hpp"
+#include "sg/sim/scenario.hpp"
+
+namespace sg::sim {
+namespace {
+
+Scenario make(const char* name, const char* description, int frames) {
+  Scenario s;
+  s.name = name;
+  s.description = description;
+  s.frames = frames;
+  return s;
+}
+
+/// A box of size (w, h, d) standing on the ground of `s` with its centre at (x, z).
+Box standing(const Scenario& s, int id, cv::Vec3d size, double x, double z, cv::Vec3d velocity,
+             std::uint32_t seed) {
+  Box b;
+  b.id = id;
+  b.size_m = size;
+  b.position_m = {x, s.height_m - size[1] / 2.0, z};
+  b.velocity_mps = velocity;
+  b.texture_seed = seed;
+  return b;
+}
+
+Scenario head_on() {
+  // Z_near 14.75 m at 3 m/s: contact at 4.75 s (frame 142.5); GT alarm from frame 53 (TTC 3 s).
+  Scenario s = make("head-on", "a 1.0 x 1.5 x 0.5 m box approaches from 15 m at 3 m/s; collides",
+                    143);
+  s.obstacles.push_back(standing(s, 1, {1.0, 1.5, 0.5}, 0.0, 15.0, {0, 0, -3.0}, 101));
+  return s;
+}
+
+Scenario head_on_fast() {
+  // Z_near 24.75 m at 6 m/s: contact at 4.04 s (frame 121.25).
+  Scenario s = make("head-on-fast",
+                    "a 1.0 x 1.5 x 0.5 m box approaches from 25 m at 6 m/s; collides", 121);
+  s.obstacles.push_back(standing(s, 1, {1.0, 1.5, 0.5}, 0.1, 25.0, {0, 0, -6.0}, 111));
+  return s;
+}
+
+Scenario crossing() {
+  // V_z = 0: never enters the envelope although it passes right in front of it.
+  Scenario s = make("crossing",
+                    "a 0.8 x 1.6 x 0.5 m box crosses from left to right 6 m ahead at 2 m/s; "
+                    "never collides",
+                    150);
+  s.obstacles.push_back(standing(s, 1, {0.8, 1.6, 0.5}, -4.0, 6.0, {2.0, 0, 0}, 201));
+  return s;
+}
+
+Scenario receding() {
+  Scenario s = make("receding", "a 1.0 x 1.5 x 0.5 m box moves away from 4 m at 2 m/s", 150);
+  s.obstacles.push_back(standing(s, 1, {1.0, 1.5, 0.5}, 0.0, 4.0, {0, 0, 2.0}, 301));
+  return s;
+}
+
+Scenario static_scene() {
+  Scenario s = make("static", "four boxes standing still at 3, 6, 10 and 16 m; nothing moves",
+                    150);
+  s.obstacles.push_back(standing(s, 1, {0.8, 1.2, 0.6}, -1.0, 3.0, {0, 0, 0}, 401));
+  s.obstacles.push_back(standing(s, 2, {1.0, 1.8, 0.5}, 0.4, 6.0, {0, 0, 0}, 402));
+  s.obstacles.push_back(standing(s, 3, {1.5, 2.5, 1.0}, 2.2, 10.0, {0, 0, 0}, 403));
+  s.obstacles.push_back(standing(s, 4, {3.0, 4.0, 1.0}, -3.5, 16.0, {0, 0, 0}, 404));
+  return s;
+}
+
+Scenario ego_wall() {
+  // Z_near 14 m at 2 m/s: 0.8 m left at the last frame (t = 6.6 s); GT alarm from t = 3.75 s.
+  Scenario s = make("ego-wall",
+                    "the camera drives at 2 m/s towards a 6 x 3 m wall 14 m ahead and stops "
+                    "0.8 m before it; collides",
+                    199);
+  s.ego_velocity_mps = {0, 0, 2.0};
+  s.obstacles.push_back(standing(s, 1, {6.0, 3.0, 0.5}, 0.0, 14.25, {0, 0, 0}, 501));
+  return s;
+}
+
+Scenario ego_pass() {
+  // X extent [1.0, 1.6] m never overlaps |X| <= 0.5 m; the camera passes it at t = 4.5 s.
+  Scenario s = make("ego-pass",
+                    "the camera drives at 2 m/s past a 0.6 x 1.5 x 0.6 m box standing 1.3 m to "
+                    "the right, 9 m ahead; never collides",
+                    150);
+  s.ego_velocity_mps = {0, 0, 2.0};
+  s.obstacles.push_back(standing(s, 1, {0.6, 1.5, 0.6}, 1.3, 9.0, {0, 0, 0}, 601));
+  return s;
+}
+
+Scenario two_obstacles() {
+  // Box 1 (left): Z_near 9.75 m at 2 m/s, contact at 4.625 s with X extent [-0.72, -0.12]:
+  // collides. Box 2 (right): X extent [1.7, 2.3] m, approaches at 1.5 m/s: never collides.
+  Scenario s = make("two-obstacles",
+                    "box 1 approaches diagonally from the left and collides; box 2 approaches on "
+                    "the right and passes beside the envelope",
+                    138);
+  s.obstacles.push_back(standing(s, 1, {0.6, 1.5, 0.5}, -2.5, 10.0, {0.45, 0, -2.0}, 701));
+  s.obstacles.push_back(standing(s, 2, {0.6, 1.5, 0.5}, 2.0, 8.0, {0, 0, -1.5}, 702));
+  return s;
+}
+
+Scenario pedestrian() {
+  // Z_near 7.85 m at 1.5 m/s: contact at 4.9 s with X extent [-0.055, 0.445]: collides.
+  Scenario s = make("pedestrian",
+                    "a thin 0.5 x 1.7 x 0.3 m box walks diagonally from the left into the path; "
+                    "collides",
+                    147);
+  s.obstacles.push_back(standing(s, 1, {0.5, 1.7, 0.3}, -2.5, 8.0, {0.55, 0, -1.5}, 801));
+  return s;
+}
+
+const std::vector<std::pair<std::string, std::function<Scenario()>>>& registry() {
+  static const std::vector<std::pair<std::string, std::function<Scenario()>>> kAll = {
+      {"head-on", head_on},         {"crossing", crossing},
+      {"receding", receding},       {"static", static_scene},
+      {"ego-wall", ego_wall},       {"ego-pass", ego_pass},
+      {"two-obstacles", two_obstacles}, {"head-on-fast", head_on_fast},
+      {"pedestrian", pedestrian},
+  };
+  return kAll;
+}
+
+}  // namespace
+
+std::vector<std::string> builtin_scenario_names() {
+  std::vector<std::string> names;
+  for (const auto& entry : registry()) names.push_back(entry.first);
+  return names;
+}
+
+Scenario builtin_scenario(const std::string& name) {
+  for (const auto& entry : registry())
+    if (entry.first == name) return entry.second();
+  std::string list;
+  for (const auto& n : builtin_scenario_names()) list += (list.empty() ? "" : ", ") + n;
+  throw core::InputError("unknown scenario '" + name + "' (built-in: " + list + ")");
+}
+
+}  // namespace sg::sim

@@ -1,0 +1,382 @@
+#include "sg/sim/renderer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+#include "sg/core/error.hpp"
+#include "texture.hpp"
+
+namespace sg::sim {
+namespace {
+
+constexpr double kSkyGray = 200.0;       // rays that hit nothing
+constexpr double kContrast = 160.0;      // gray levels per unit of texture_value (std about 40)
+constexpr double kGroundStretchZ = 2.5;  // ground texture is stretched along Z (less blur far off)
+constexpr double kMinHitDepth = 1e-6;    // m; hits closer than this are ignored
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+enum class Surface : std::uint8_t { kSky, kGround, kWall, kBox };
+
+/// A box at the frame time, in world coordinates.
+struct BoxNow {
+  cv::Vec3d lo, hi, centre, velocity;
+  int id = 0;
+  std::uint32_t seed = 0;
+  double albedo = 0.0;
+};
+
+/// Everything the ray caster needs for one frame.
+struct Scene {
+  double f = 0, cx = 0, cy = 0, baseline = 0, dt = 0;
+  cv::Vec3d eye;       // left camera at the frame time
+  cv::Vec3d eye_prev;  // left camera one frame earlier
+  double ground_y = 0, wall_z = 0, wall_top_y = 0;
+  std::uint32_t ground_seed = 0, wall_seed = 0;
+  double ground_albedo = 0, wall_albedo = 0;
+  std::vector<BoxNow> boxes;
+};
+
+struct Hit {
+  double depth = kInf;  // ray parameter of (dx, dy, 1) = depth in the camera, m
+  Surface surface = Surface::kSky;
+  int box = -1;   // index into Scene::boxes
+  int axis = 2;   // normal axis of the face hit
+  int side = 0;   // 0 = the face at the low coordinate, 1 = the high one
+};
+
+/// Base gray level of a surface, from its seed.
+double albedo_of(std::uint32_t seed) { return 90.0 + static_cast<double>(hash_u32(seed) % 80U); }
+
+Scene make_scene(const Scenario& s, int index) {
+  Scene sc;
+  const double t = index / s.camera.fps;
+  sc.f = s.camera.focal_px;
+  sc.cx = s.camera.cx;
+  sc.cy = s.camera.cy;
+  sc.baseline = s.camera.baseline_m;
+  sc.dt = 1.0 / s.camera.fps;
+  sc.eye = s.ego_velocity_mps * t;
+  sc.eye_prev = s.ego_velocity_mps * (t - sc.dt);
+  sc.ground_y = s.height_m;
+  sc.wall_z = s.background_z_m;
+  sc.wall_top_y = s.height_m - s.background_height_m;
+  sc.ground_seed = s.ground_seed;
+  sc.wall_seed = s.background_seed;
+  sc.ground_albedo = albedo_of(s.ground_seed);
+  sc.wall_albedo = albedo_of(s.background_seed);
+  for (const Box& b : s.obstacles) {
+    BoxNow n;
+    n.centre = b.position_m + b.velocity_mps * t;
+    n.lo = n.centre - b.size_m * 0.5;
+    n.hi = n.centre + b.size_m * 0.5;
+    n.velocity = b.velocity_mps;
+    n.id = b.id;
+    n.seed = b.texture_seed;
+    n.albedo = albedo_of(b.texture_seed);
+    sc.boxes.push_back(n);
+  }
+  return sc;
+}
+
+double safe_component(double v) {
+  constexpr double kTiny = 1e-12;
+  return std::abs(v) < kTiny ? (v < 0 ? -kTiny : kTiny) : v;
+}
+
+/// Nearest surface along o + s * (dx, dy, 1), s > 0.
+Hit cast(const Scene& sc, const cv::Vec3d& o, double dx, double dy) {
+  Hit hit;
+  if (dy > 0) {
+    const double s = (sc.ground_y - o[1]) / dy;
+    if (s > kMinHitDepth) {
+      hit.depth = s;
+      hit.surface = Surface::kGround;
+      hit.axis = 1;
+    }
+  }
+  {
+    const double s = sc.wall_z - o[2];
+    if (s > kMinHitDepth && s < hit.depth && o[1] + s * dy >= sc.wall_top_y) {
+      hit.depth = s;
+      hit.surface = Surface::kWall;
+      hit.axis = 2;
+    }
+  }
+  const double inv[3] = {1.0 / safe_component(dx), 1.0 / safe_component(dy), 1.0};
+  for (std::size_t i = 0; i < sc.boxes.size(); ++i) {
+    const BoxNow& b = sc.boxes[i];
+    double t_near = -kInf, t_far = kInf;
+    int axis = 0, side = 0;
+    for (int a = 0; a < 3; ++a) {
+      double t1 = (b.lo[a] - o[a]) * inv[a];
+      double t2 = (b.hi[a] - o[a]) * inv[a];
+      int entry_side = 0;
+      if (t1 > t2) {
+        std::swap(t1, t2);
+        entry_side = 1;
+      }
+      if (t1 > t_near) {
+        t_near = t1;
+        axis = a;
+        side = entry_side;
+      }
+      t_far = std::min(t_far, t2);
+    }
+    if (t_near <= t_far && t_near > kMinHitDepth && t_near < hit.depth) {
+      hit.depth = t_near;
+      hit.surface = Surface::kBox;
+      hit.box = static_cast<int>(i);
+      hit.axis = axis;
+      hit.side = side;
+    }
+  }
+  return hit;
+}
+
+/// Size in texture units of the pixel footprint on a face with normal `axis`, using ray
+/// differentials of the direction (dx, dy, 1) at depth `depth`.
+double footprint(const Scene& sc, int axis, double depth, double dx, double dy, int u_axis,
+                 int v_axis, double u_scale, double v_scale) {
+  cv::Vec3d ddx(1, 0, 0), ddy(0, 1, 0);
+  const cv::Vec3d dir(dx, dy, 1.0);
+  if (axis == 0) ddx -= dir * (1.0 / safe_component(dx));
+  if (axis == 1) ddy -= dir * (1.0 / safe_component(dy));
+  const double fu = std::max(std::abs(ddx[u_axis]), std::abs(ddy[u_axis])) / u_scale;
+  const double fv = std::max(std::abs(ddx[v_axis]), std::abs(ddy[v_axis])) / v_scale;
+  return depth / sc.f * std::max(fu, fv);
+}
+
+/// Gray level (before noise and gain) of the surface hit by the ray from o.
+double shade(const Scene& sc, const Hit& hit, const cv::Vec3d& o, double dx, double dy) {
+  if (hit.surface == Surface::kSky) return kSkyGray;
+  const cv::Vec3d p = o + cv::Vec3d(dx, dy, 1.0) * hit.depth;
+  if (hit.surface == Surface::kGround) {
+    const double fp = footprint(sc, 1, hit.depth, dx, dy, 0, 2, 1.0, kGroundStretchZ);
+    return sc.ground_albedo +
+           kContrast * texture_value(p[0], p[2] / kGroundStretchZ, sc.ground_seed, fp);
+  }
+  if (hit.surface == Surface::kWall) {
+    const double fp = footprint(sc, 2, hit.depth, dx, dy, 0, 1, 1.0, 1.0);
+    return sc.wall_albedo + kContrast * texture_value(p[0], p[1], sc.wall_seed, fp);
+  }
+  const BoxNow& b = sc.boxes[static_cast<std::size_t>(hit.box)];
+  const cv::Vec3d local = p - b.centre;
+  // Texture axes of each face: X faces use (Z, Y), Y faces (X, Z), Z faces (X, Y).
+  static constexpr int kU[3] = {2, 0, 0};
+  static constexpr int kV[3] = {1, 2, 1};
+  static constexpr double kFaceShade[3] = {0.8, 1.15, 1.0};
+  const int u = kU[hit.axis], v = kV[hit.axis];
+  const double fp = footprint(sc, hit.axis, hit.depth, dx, dy, u, v, 1.0, 1.0);
+  const auto face = static_cast<std::uint32_t>(hit.axis * 2 + hit.side);
+  return b.albedo * kFaceShade[hit.axis] +
+         kContrast * texture_value(local[u], local[v], hash_combine(b.seed, face), fp);
+}
+
+/// Outputs of render_rows; null members are not produced.
+struct RowTargets {
+  cv::Mat* gray = nullptr;         // CV_8UC1
+  const cv::Mat* noise = nullptr;  // CV_32F, may be null
+  double gain = 1.0;
+  cv::Mat* disparity = nullptr;  // CV_32F
+  cv::Mat* flow = nullptr;       // CV_32FC2
+  cv::Mat* ids = nullptr;        // CV_16U
+};
+
+/// Renders rows [rows.start, rows.end) of the camera at `eye`. Each pixel depends only on its own
+/// ray, so any split into row ranges gives the same images.
+void render_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, cv::Range rows,
+                 int width) {
+  for (int y = rows.start; y < rows.end; ++y) {
+    const double dy = (y - sc.cy) / sc.f;
+    auto* gray = out.gray ? out.gray->ptr<std::uint8_t>(y) : nullptr;
+    const auto* noise = out.noise ? out.noise->ptr<float>(y) : nullptr;
+    auto* disp = out.disparity ? out.disparity->ptr<float>(y) : nullptr;
+    auto* flow = out.flow ? out.flow->ptr<cv::Vec2f>(y) : nullptr;
+    auto* ids = out.ids ? out.ids->ptr<std::uint16_t>(y) : nullptr;
+    for (int x = 0; x < width; ++x) {
+      const double dx = (x - sc.cx) / sc.f;
+      const Hit hit = cast(sc, eye, dx, dy);
+      if (gray) {
+        double value = shade(sc, hit, eye, dx, dy) * out.gain;
+        if (noise) value += noise[x];
+        gray[x] = cv::saturate_cast<std::uint8_t>(value);
+      }
+      const bool is_box = hit.surface == Surface::kBox;
+      if (ids) ids[x] = is_box ? static_cast<std::uint16_t>(sc.boxes[hit.box].id) : 0;
+      if (disp) {
+        disp[x] = hit.surface == Surface::kSky
+                      ? 0.0f
+                      : static_cast<float>(sc.f * sc.baseline / hit.depth);
+      }
+      if (flow) {
+        cv::Vec2f q(0.0f, 0.0f);
+        if (hit.surface != Surface::kSky) {
+          // The same surface point one frame earlier, seen from the camera one frame earlier.
+          cv::Vec3d p = eye + cv::Vec3d(dx, dy, 1.0) * hit.depth;
+          if (is_box) p -= sc.boxes[hit.box].velocity * sc.dt;
+          const cv::Vec3d rel = p - sc.eye_prev;
+          if (rel[2] > kMinHitDepth) {
+            q[0] = static_cast<float>(sc.cx + sc.f * rel[0] / rel[2] - x);
+            q[1] = static_cast<float>(sc.cy + sc.f * rel[1] / rel[2] - y);
+          }
+        }
+        flow[x] = q;
+      }
+    }
+  }
+}
+
+void render_parallel(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, int width,
+                     int height) {
+  cv::parallel_for_(cv::Range(0, height),
+                    [&](const cv::Range& r) { render_rows(sc, eye, out, r, width); });
+}
+
+/// Per-obstacle truth from the ids map; fills danger when given.
+core::FrameTruth frame_truth(const Scenario& s, int index, const cv::Mat& ids, cv::Mat* danger) {
+  core::FrameTruth truth;
+  truth.frame = index;
+  const double t = index / s.camera.fps;
+  int max_id = 0;
+  for (const Box& b : s.obstacles) max_id = std::max(max_id, b.id);
+  std::vector<int> count(static_cast<std::size_t>(max_id) + 1, 0);
+  for (int y = 0; y < ids.rows; ++y) {
+    const auto* row = ids.ptr<std::uint16_t>(y);
+    for (int x = 0; x < ids.cols; ++x)
+      if (row[x] != 0) ++count[row[x]];
+  }
+  std::vector<std::uint8_t> lut(count.size(), 0);
+  for (const Box& b : s.obstacles) {
+    core::ObstacleTruth o = box_collision(s, b, t);
+    o.pixels = count[static_cast<std::size_t>(b.id)];
+    if (o.colliding) {
+      lut[static_cast<std::size_t>(b.id)] = 255;
+      if (o.pixels >= s.min_area_px && o.pixels > 0) truth.alarm = true;
+    }
+    truth.obstacles.push_back(o);
+  }
+  if (danger) {
+    danger->create(ids.size(), CV_8UC1);
+    for (int y = 0; y < ids.rows; ++y) {
+      const auto* row = ids.ptr<std::uint16_t>(y);
+      auto* out = danger->ptr<std::uint8_t>(y);
+      for (int x = 0; x < ids.cols; ++x) out[x] = lut[row[x]];
+    }
+  }
+  return truth;
+}
+
+void check_index(const Scenario& s, int index) {
+  if (index < 0 || index >= s.frames)
+    throw std::out_of_range("frame " + std::to_string(index) + " outside scenario '" + s.name +
+                            "' (0.." + std::to_string(s.frames - 1) + ")");
+}
+
+}  // namespace
+
+core::ObstacleTruth box_collision(const Scenario& s, const Box& box, double t_s) {
+  core::ObstacleTruth o;
+  o.id = box.id;
+  const core::Envelope& e = s.envelope;
+  const cv::Vec3d rel = box.position_m + (box.velocity_mps - s.ego_velocity_mps) * t_s;
+  const cv::Vec3d v = box.velocity_mps - s.ego_velocity_mps;
+  const cv::Vec3d half = box.size_m * 0.5;
+  const auto overlaps_at = [&](double dt) {
+    const cv::Vec3d c = rel + v * dt;
+    return c[0] + half[0] >= -e.half_width_m && c[0] - half[0] <= e.half_width_m &&
+           c[1] + half[1] >= e.y_top_m && c[1] - half[1] <= e.y_bottom_m;
+  };
+  const double z_near = rel[2] - half[2];
+  const double z_far = rel[2] + half[2];
+  if (z_near <= e.z_contact_m) {
+    // Already at the contact depth: colliding only if it is in the envelope now.
+    if (z_far >= 0.0 && overlaps_at(0.0)) {
+      o.colliding = true;
+      o.ttc_s = 0.0;
+    }
+    return o;
+  }
+  if (v[2] >= 0.0) return o;
+  const double t_c = (z_near - e.z_contact_m) / (-v[2]);
+  if (t_c <= e.horizon_s && overlaps_at(t_c)) {
+    o.colliding = true;
+    o.ttc_s = t_c;
+  }
+  return o;
+}
+
+Renderer::Renderer(Scenario scenario) : scenario_(std::move(scenario)) {
+  core::throw_if_invalid(validate(scenario_), "invalid scenario '" + scenario_.name + "'");
+}
+
+RenderedFrame Renderer::render(int index) const {
+  check_index(scenario_, index);
+  const Scenario& s = scenario_;
+  const int w = s.camera.width, h = s.camera.height;
+  const Scene sc = make_scene(s, index);
+
+  RenderedFrame r;
+  r.frame.index = index;
+  r.frame.time_s = index / s.camera.fps;
+  r.frame.left.create(h, w, CV_8UC1);
+  r.frame.right.create(h, w, CV_8UC1);
+  r.maps.disparity.create(h, w, CV_32FC1);
+  r.maps.ids.create(h, w, CV_16UC1);
+  if (index > 0) r.maps.flow.create(h, w, CV_32FC2);
+
+  // Noise is drawn serially from one generator per (seed, frame, side): thread-count independent.
+  cv::Mat noise[2];
+  if (s.noise_sigma > 0) {
+    for (int side = 0; side < 2; ++side) {
+      const std::uint32_t key = hash_combine(hash_combine(s.noise_seed, static_cast<std::uint32_t>(index)),
+                                             static_cast<std::uint32_t>(side));
+      cv::RNG rng((static_cast<std::uint64_t>(key) << 32) | hash_u32(key + 1U));
+      noise[side].create(h, w, CV_32FC1);
+      rng.fill(noise[side], cv::RNG::NORMAL, 0.0, s.noise_sigma);
+    }
+  }
+
+  RowTargets left;
+  left.gray = &r.frame.left;
+  left.noise = noise[0].empty() ? nullptr : &noise[0];
+  left.disparity = &r.maps.disparity;
+  left.flow = index > 0 ? &r.maps.flow : nullptr;
+  left.ids = &r.maps.ids;
+  render_parallel(sc, sc.eye, left, w, h);
+
+  RowTargets right;
+  right.gray = &r.frame.right;
+  right.noise = noise[1].empty() ? nullptr : &noise[1];
+  right.gain = s.right_gain;
+  render_parallel(sc, sc.eye + cv::Vec3d(s.camera.baseline_m, 0, 0), right, w, h);
+
+  r.truth = frame_truth(s, index, r.maps.ids, &r.maps.danger);
+  return r;
+}
+
+core::FrameTruth Renderer::truth(int index) const {
+  check_index(scenario_, index);
+  const Scene sc = make_scene(scenario_, index);
+  cv::Mat ids(scenario_.camera.height, scenario_.camera.width, CV_16UC1);
+  RowTargets out;
+  out.ids = &ids;
+  render_parallel(sc, sc.eye, out, ids.cols, ids.rows);
+  return frame_truth(scenario_, index, ids, nullptr);
+}
+
+ScenarioSource::ScenarioSource(Scenario scenario) : renderer_(std::move(scenario)) {}
+
+std::optional<core::StereoFrame> ScenarioSource::next() {
+  if (next_index_ >= renderer_.scenario().frames) return std::nullopt;
+  last_ = renderer_.render(next_index_++);
+  return last_.frame;
+}
+
+const core::Camera& ScenarioSource::camera() const { return renderer_.scenario().camera; }
+
+int ScenarioSource::size() const { return renderer_.scenario().frames; }
+
+}  // namespace sg::sim

@@ -1,0 +1,332 @@
+#include "sg/sim/scenario.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "sg/core/error.hpp"
+
+namespace sg::sim {
+namespace {
+
+bool finite(const cv::Vec3d& v) {
+  return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+std::string to_text(double v) {
+  char buf[64];
+  const auto result = std::to_chars(buf, buf + sizeof(buf), v);
+  return std::string(buf, result.ptr);
+}
+
+std::string to_text(const cv::Vec3d& v) {
+  std::string out = "[";
+  out += to_text(v[0]);
+  out += ", ";
+  out += to_text(v[1]);
+  out += ", ";
+  out += to_text(v[2]);
+  out += "]";
+  return out;
+}
+
+/// Collects "<field>=<value>: <rule>" lines.
+class Checker {
+ public:
+  explicit Checker(std::vector<std::string>& out) : out_(out) {}
+  template <typename T>
+  void require(bool ok, const std::string& field, const T& value, const char* rule) {
+    if (ok) return;
+    std::ostringstream s;
+    s << field << "=" << value << ": " << rule;
+    out_.push_back(s.str());
+  }
+
+ private:
+  std::vector<std::string>& out_;
+};
+
+// ---- YAML reading -------------------------------------------------------------------------------
+
+/// Reads typed fields and throws InputError naming the file, line and field on any problem.
+class YamlReader {
+ public:
+  explicit YamlReader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& field,
+                         const std::string& problem) const {
+    std::string where = file_;
+    if (node.IsDefined() && node.Mark().line >= 0)
+      where += ":" + std::to_string(node.Mark().line + 1);
+    throw core::InputError(where + ": field '" + field + "': " + problem);
+  }
+
+  void expect_map(const YAML::Node& node, const std::string& field,
+                  const std::set<std::string>& known) const {
+    if (!node.IsMap()) fail(node, field, "expected a mapping");
+    for (const auto& kv : node) {
+      std::string key;
+      try {
+        key = kv.first.as<std::string>();
+      } catch (const YAML::Exception&) {
+        fail(kv.first, field, "keys must be strings");
+      }
+      if (!known.count(key)) {
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        const std::string name = field.empty() ? key : field + "." + key;
+        fail(kv.first, name, "unknown key (known: " + list + ")");
+      }
+    }
+  }
+
+  double number(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsScalar()) fail(node, field, "expected a number");
+    try {
+      return node.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(node, field, "expected a number, got '" + node.Scalar() + "'");
+    }
+  }
+
+  int integer(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsScalar()) fail(node, field, "expected an integer");
+    try {
+      return node.as<int>();
+    } catch (const YAML::Exception&) {
+      fail(node, field, "expected an integer, got '" + node.Scalar() + "'");
+    }
+  }
+
+  std::uint32_t seed(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsScalar()) fail(node, field, "expected an integer in 0..4294967295");
+    long long v = -1;
+    try {
+      v = node.as<long long>();
+    } catch (const YAML::Exception&) {
+      fail(node, field, "expected an integer in 0..4294967295, got '" + node.Scalar() + "'");
+    }
+    if (v < 0 || v > static_cast<long long>(std::numeric_limits<std::uint32_t>::max()))
+      fail(node, field, "expected an integer in 0..4294967295, got " + std::to_string(v));
+    return static_cast<std::uint32_t>(v);
+  }
+
+  std::string text(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsScalar()) fail(node, field, "expected a string");
+    return node.Scalar();
+  }
+
+  cv::Vec3d vec3(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsSequence() || node.size() != 3) fail(node, field, "expected [x, y, z]");
+    cv::Vec3d v;
+    for (int i = 0; i < 3; ++i)
+      v[i] = number(node[i], field + "[" + std::to_string(i) + "]");
+    return v;
+  }
+
+ private:
+  std::string file_;
+};
+
+void read_camera(const YamlReader& r, const YAML::Node& n, core::Camera& c) {
+  r.expect_map(n, "camera", {"width", "height", "focal_px", "baseline_m", "cx", "cy", "fps"});
+  if (n["width"]) c.width = r.integer(n["width"], "camera.width");
+  if (n["height"]) c.height = r.integer(n["height"], "camera.height");
+  if (n["focal_px"]) c.focal_px = r.number(n["focal_px"], "camera.focal_px");
+  if (n["baseline_m"]) c.baseline_m = r.number(n["baseline_m"], "camera.baseline_m");
+  if (n["cx"]) c.cx = r.number(n["cx"], "camera.cx");
+  if (n["cy"]) c.cy = r.number(n["cy"], "camera.cy");
+  if (n["fps"]) c.fps = r.number(n["fps"], "camera.fps");
+}
+
+void read_envelope(const YamlReader& r, const YAML::Node& n, core::Envelope& e) {
+  r.expect_map(n, "envelope",
+               {"half_width_m", "y_top_m", "y_bottom_m", "z_contact_m", "horizon_s"});
+  if (n["half_width_m"]) e.half_width_m = r.number(n["half_width_m"], "envelope.half_width_m");
+  if (n["y_top_m"]) e.y_top_m = r.number(n["y_top_m"], "envelope.y_top_m");
+  if (n["y_bottom_m"]) e.y_bottom_m = r.number(n["y_bottom_m"], "envelope.y_bottom_m");
+  if (n["z_contact_m"]) e.z_contact_m = r.number(n["z_contact_m"], "envelope.z_contact_m");
+  if (n["horizon_s"]) e.horizon_s = r.number(n["horizon_s"], "envelope.horizon_s");
+}
+
+Box read_box(const YamlReader& r, const YAML::Node& n, const std::string& field) {
+  r.expect_map(n, field, {"id", "size_m", "position_m", "velocity_mps", "texture_seed"});
+  Box b;
+  if (n["id"]) b.id = r.integer(n["id"], field + ".id");
+  if (n["size_m"]) b.size_m = r.vec3(n["size_m"], field + ".size_m");
+  if (n["position_m"]) b.position_m = r.vec3(n["position_m"], field + ".position_m");
+  if (n["velocity_mps"]) b.velocity_mps = r.vec3(n["velocity_mps"], field + ".velocity_mps");
+  if (n["texture_seed"]) b.texture_seed = r.seed(n["texture_seed"], field + ".texture_seed");
+  return b;
+}
+
+Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::string& path) {
+  if (root.IsNull()) r.fail(root, "(document)", "the file is empty");
+  r.expect_map(root, "",
+               {"name", "description", "frames", "camera", "height_m", "ego_velocity_mps",
+                "background_z_m", "background_height_m", "ground_seed", "background_seed",
+                "noise_sigma", "right_gain", "noise_seed", "envelope", "min_area_px",
+                "obstacles"});
+  Scenario s;
+  s.name = std::filesystem::path(path).stem().string();
+  if (root["name"]) s.name = r.text(root["name"], "name");
+  if (root["description"]) s.description = r.text(root["description"], "description");
+  if (root["frames"]) s.frames = r.integer(root["frames"], "frames");
+  if (root["camera"]) read_camera(r, root["camera"], s.camera);
+  if (root["height_m"]) s.height_m = r.number(root["height_m"], "height_m");
+  if (root["ego_velocity_mps"])
+    s.ego_velocity_mps = r.vec3(root["ego_velocity_mps"], "ego_velocity_mps");
+  if (root["background_z_m"]) s.background_z_m = r.number(root["background_z_m"], "background_z_m");
+  if (root["background_height_m"])
+    s.background_height_m = r.number(root["background_height_m"], "background_height_m");
+  if (root["ground_seed"]) s.ground_seed = r.seed(root["ground_seed"], "ground_seed");
+  if (root["background_seed"])
+    s.background_seed = r.seed(root["background_seed"], "background_seed");
+  if (root["noise_sigma"]) s.noise_sigma = r.number(root["noise_sigma"], "noise_sigma");
+  if (root["right_gain"]) s.right_gain = r.number(root["right_gain"], "right_gain");
+  if (root["noise_seed"]) s.noise_seed = r.seed(root["noise_seed"], "noise_seed");
+  if (root["envelope"]) read_envelope(r, root["envelope"], s.envelope);
+  if (root["min_area_px"]) s.min_area_px = r.integer(root["min_area_px"], "min_area_px");
+  if (const YAML::Node obstacles = root["obstacles"]) {
+    if (!obstacles.IsSequence() && !obstacles.IsNull())
+      r.fail(obstacles, "obstacles", "expected a list of boxes");
+    for (std::size_t i = 0; i < obstacles.size(); ++i)
+      s.obstacles.push_back(
+          read_box(r, obstacles[i], "obstacles[" + std::to_string(i) + "]"));
+  }
+  return s;
+}
+
+}  // namespace
+
+std::vector<std::string> validate(const Scenario& s) {
+  std::vector<std::string> out = core::validate(s.camera);
+  Checker c(out);
+  c.require(s.frames >= 2, "frames", s.frames, "must be >= 2");
+  c.require(std::isfinite(s.height_m) && s.height_m > 0, "height_m", s.height_m, "must be > 0");
+  c.require(finite(s.ego_velocity_mps), "ego_velocity_mps", to_text(s.ego_velocity_mps),
+            "must be finite");
+  c.require(std::isfinite(s.background_z_m) && s.background_z_m > 0, "background_z_m",
+            s.background_z_m, "must be > 0");
+  c.require(std::isfinite(s.background_height_m) && s.background_height_m > 0,
+            "background_height_m", s.background_height_m, "must be > 0");
+  c.require(std::isfinite(s.noise_sigma) && s.noise_sigma >= 0, "noise_sigma", s.noise_sigma,
+            "must be >= 0");
+  c.require(std::isfinite(s.right_gain) && s.right_gain > 0, "right_gain", s.right_gain,
+            "must be > 0");
+  c.require(s.min_area_px >= 0, "min_area_px", s.min_area_px, "must be >= 0");
+  for (const auto& e : core::validate(s.envelope)) out.push_back(e);
+  std::set<int> ids;
+  for (std::size_t i = 0; i < s.obstacles.size(); ++i) {
+    const Box& b = s.obstacles[i];
+    const std::string field = "obstacles[" + std::to_string(i) + "]";
+    c.require(b.id >= 1 && b.id <= 65535, field + ".id", b.id, "must be in 1..65535");
+    c.require(ids.insert(b.id).second, field + ".id", b.id, "must be unique");
+    c.require(finite(b.size_m) && b.size_m[0] > 0 && b.size_m[1] > 0 && b.size_m[2] > 0,
+              field + ".size_m", to_text(b.size_m), "each must be > 0");
+    c.require(finite(b.position_m), field + ".position_m", to_text(b.position_m),
+              "must be finite");
+    c.require(finite(b.velocity_mps), field + ".velocity_mps", to_text(b.velocity_mps),
+              "must be finite");
+  }
+  return out;
+}
+
+Scenario load_scenario_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw core::InputError(path + ": scenario file not found");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::ParserException& e) {
+    throw core::InputError(path + ":" + std::to_string(e.mark.line + 1) +
+                           ": YAML syntax error: " + e.msg);
+  } catch (const YAML::Exception& e) {
+    throw core::InputError(path + ": cannot read scenario: " + e.msg);
+  }
+  const YamlReader reader(path);
+  Scenario s = read_scenario(reader, root, path);
+  core::throw_if_invalid(validate(s), path + ": invalid scenario");
+  return s;
+}
+
+Scenario resolve_scenario(const std::string& name_or_path) {
+  for (const auto& name : builtin_scenario_names())
+    if (name == name_or_path) return builtin_scenario(name);
+  std::error_code ec;
+  if (std::filesystem::exists(name_or_path, ec)) return load_scenario_file(name_or_path);
+  std::string list;
+  for (const auto& name : builtin_scenario_names()) list += (list.empty() ? "" : ", ") + name;
+  throw core::InputError("unknown scenario '" + name_or_path +
+                         "' (not a file; built-in: " + list + ")");
+}
+
+std::string to_yaml(const Scenario& s) {
+  YAML::Emitter e;
+  const auto vec = [&e](const cv::Vec3d& v) {
+    e << YAML::Flow << YAML::BeginSeq << to_text(v[0]) << to_text(v[1]) << to_text(v[2])
+      << YAML::EndSeq;
+  };
+  e << YAML::BeginMap;
+  e << YAML::Key << "name" << YAML::Value << YAML::DoubleQuoted << s.name;
+  e << YAML::Key << "description" << YAML::Value << YAML::DoubleQuoted << s.description;
+  e << YAML::Key << "frames" << YAML::Value << s.frames;
+  e << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "width" << YAML::Value << s.camera.width;
+  e << YAML::Key << "height" << YAML::Value << s.camera.height;
+  e << YAML::Key << "focal_px" << YAML::Value << to_text(s.camera.focal_px);
+  e << YAML::Key << "baseline_m" << YAML::Value << to_text(s.camera.baseline_m);
+  e << YAML::Key << "cx" << YAML::Value << to_text(s.camera.cx);
+  e << YAML::Key << "cy" << YAML::Value << to_text(s.camera.cy);
+  e << YAML::Key << "fps" << YAML::Value << to_text(s.camera.fps);
+  e << YAML::EndMap;
+  e << YAML::Key << "height_m" << YAML::Value << to_text(s.height_m);
+  e << YAML::Key << "ego_velocity_mps" << YAML::Value;
+  vec(s.ego_velocity_mps);
+  e << YAML::Key << "background_z_m" << YAML::Value << to_text(s.background_z_m);
+  e << YAML::Key << "background_height_m" << YAML::Value << to_text(s.background_height_m);
+  e << YAML::Key << "ground_seed" << YAML::Value << s.ground_seed;
+  e << YAML::Key << "background_seed" << YAML::Value << s.background_seed;
+  e << YAML::Key << "noise_sigma" << YAML::Value << to_text(s.noise_sigma);
+  e << YAML::Key << "right_gain" << YAML::Value << to_text(s.right_gain);
+  e << YAML::Key << "noise_seed" << YAML::Value << s.noise_seed;
+  e << YAML::Key << "envelope" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "half_width_m" << YAML::Value << to_text(s.envelope.half_width_m);
+  e << YAML::Key << "y_top_m" << YAML::Value << to_text(s.envelope.y_top_m);
+  e << YAML::Key << "y_bottom_m" << YAML::Value << to_text(s.envelope.y_bottom_m);
+  e << YAML::Key << "z_contact_m" << YAML::Value << to_text(s.envelope.z_contact_m);
+  e << YAML::Key << "horizon_s" << YAML::Value << to_text(s.envelope.horizon_s);
+  e << YAML::EndMap;
+  e << YAML::Key << "min_area_px" << YAML::Value << s.min_area_px;
+  e << YAML::Key << "obstacles" << YAML::Value << YAML::BeginSeq;
+  for (const Box& b : s.obstacles) {
+    e << YAML::BeginMap;
+    e << YAML::Key << "id" << YAML::Value << b.id;
+    e << YAML::Key << "size_m" << YAML::Value;
+    vec(b.size_m);
+    e << YAML::Key << "position_m" << YAML::Value;
+    vec(b.position_m);
+    e << YAML::Key << "velocity_mps" << YAML::Value;
+    vec(b.velocity_mps);
+    e << YAML::Key << "texture_seed" << YAML::Value << b.texture_seed;
+    e << YAML::EndMap;
+  }
+  e << YAML::EndSeq;
+  e << YAML::EndMap;
+  return std::string(e.c_str()) + "\n";
+}
+
+void save_scenario_file(const Scenario& s, const std::string& path) {
+  std::ofstream out(path);
+  out << to_yaml(s);
+  if (!out) throw core::InputError(path + ": cannot write scenario file");
+}
+
+}  // namespace sg::sim

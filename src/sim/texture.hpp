@@ -1,0 +1,92 @@
+#pragma once
+/// Procedural surface texture of the simulator: band-limited multi-octave value noise, a pure
+/// function of surface coordinates in metres, so textures stay fixed to the objects.
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace sg::sim {
+
+/// Integer hash (lowbias32 style); good enough to decorrelate lattice points and seeds.
+inline std::uint32_t hash_u32(std::uint32_t h) {
+  h ^= h >> 16;
+  h *= 0x7feb352dU;
+  h ^= h >> 15;
+  h *= 0x846ca68bU;
+  h ^= h >> 16;
+  return h;
+}
+
+/// Hash of several words.
+inline std::uint32_t hash_combine(std::uint32_t a, std::uint32_t b) {
+  return hash_u32(a ^ (b + 0x9e3779b9U + (a << 6) + (a >> 2)));
+}
+
+constexpr std::uint32_t kLatticeBits = 8;
+constexpr std::uint32_t kLatticeMask = (1U << kLatticeBits) - 1;
+
+/// A fixed 256 x 256 table of values uniform in [-1, 1): the lattice of every octave of every
+/// texture, read at a per-(seed, octave) offset (cheaper than hashing every lattice point).
+inline const float* random_lattice() {
+  static const std::vector<float> kTable = [] {
+    std::vector<float> t(std::size_t{1} << (2 * kLatticeBits));
+    for (std::uint32_t i = 0; i < t.size(); ++i)
+      t[i] = static_cast<float>(hash_u32(i * 0x8da6b343U + 0x5bd1e995U) >> 8) *
+                 (2.0f / 16777216.0f) -
+             1.0f;
+    return t;
+  }();
+  return kTable.data();
+}
+
+struct TextureParams {
+  double finest_cell_m = 0.003;  ///< lattice spacing of the finest octave, m
+  int octaves = 12;              ///< octave k has lattice spacing finest_cell_m * 2^k
+  double fade_in_px = 2.0;       ///< an octave is absent below this many pixels per cell ...
+  double full_in_px = 4.0;       ///< ... and at full weight above this (anti-aliasing)
+  double fade_out_px = 32.0;     ///< coarse octaves fade out above this many pixels per cell ...
+  double gone_px = 64.0;         ///< ... and are absent above this (keeps the cost bounded)
+};
+
+/// Texture value in about [-1, 1] (standard deviation about 0.25) at surface point (u, v) in
+/// metres, prefiltered for a pixel footprint of `footprint_m` metres: octaves whose cells are
+/// smaller than fade_in_px pixels are left out, so far textures blur instead of aliasing.
+inline double texture_value(double u, double v, std::uint32_t seed, double footprint_m,
+                            const TextureParams& p = TextureParams{}) {
+  const auto smooth = [](double a) { return a * a * (3.0 - 2.0 * a); };
+  const float* lattice = random_lattice();
+  double sum = 0.0;
+  double cell = p.finest_cell_m;
+  double inv_cell = 1.0 / p.finest_cell_m;
+  const double inv_footprint = 1.0 / footprint_m;
+  for (int k = 0; k < p.octaves; ++k, cell *= 2.0, inv_cell *= 0.5) {
+    const double r = cell * inv_footprint;  // pixels per cell
+    if (r <= p.fade_in_px) continue;
+    if (r >= p.gone_px) break;
+    double w = 1.0;
+    if (r < p.full_in_px) w = smooth((r - p.fade_in_px) / (p.full_in_px - p.fade_in_px));
+    if (r > p.fade_out_px) w *= 1.0 - smooth((r - p.fade_out_px) / (p.gone_px - p.fade_out_px));
+    // Each (seed, octave) reads the shared random lattice at its own offset.
+    const std::uint32_t s = hash_u32(seed + static_cast<std::uint32_t>(k) * 0x9e3779b9U);
+    const double x = u * inv_cell, y = v * inv_cell;
+    // Floor without a library call (std::floor is not inlined without SSE4.1).
+    std::int64_t jx = static_cast<std::int64_t>(x), jy = static_cast<std::int64_t>(y);
+    jx -= x < static_cast<double>(jx);
+    jy -= y < static_cast<double>(jy);
+    const auto a = static_cast<float>(smooth(x - static_cast<double>(jx)));
+    const auto b = static_cast<float>(smooth(y - static_cast<double>(jy)));
+    const std::uint32_t ix = static_cast<std::uint32_t>(jx) + s;
+    const std::uint32_t iy = static_cast<std::uint32_t>(jy) + (s >> 16);
+    const std::uint32_t r0 = (iy & kLatticeMask) << kLatticeBits;
+    const std::uint32_t r1 = ((iy + 1) & kLatticeMask) << kLatticeBits;
+    const std::uint32_t c0 = ix & kLatticeMask, c1 = (ix + 1) & kLatticeMask;
+    const float n00 = lattice[r0 | c0], n10 = lattice[r0 | c1];
+    const float n01 = lattice[r1 | c0], n11 = lattice[r1 | c1];
+    const float top = n00 + a * (n10 - n00), bottom = n01 + a * (n11 - n01);
+    sum += w * (top + b * (bottom - top));
+  }
+  // About five octaves are active; their sum has a standard deviation near 0.4 * sqrt(5).
+  return sum * (1.0 / 3.6);
+}
+
+}  // namespace sg::sim

@@ -1,0 +1,326 @@
+#include "sg/vision/scene_flow.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+
+#include "sg/core/error.hpp"
+
+namespace sg::vision {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// Splits a coordinate into integer cell and fraction; false outside [0, n-1] or not finite.
+inline bool split(float v, int n, int& i, float& f) {
+  if (!(v >= 0.0f) || !(v <= static_cast<float>(n - 1))) return false;  // also rejects NaN
+  i = static_cast<int>(v);
+  f = v - static_cast<float>(i);
+  return true;
+}
+
+void check_same(const cv::Mat& ref, const cv::Mat& m, int type, const char* what) {
+  if (m.type() != type || m.size() != ref.size()) {
+    std::ostringstream s;
+    s << "scene flow: " << what << " must be " << cv::typeToString(type) << " of size "
+      << ref.cols << "x" << ref.rows << " (got " << cv::typeToString(m.type()) << " "
+      << m.cols << "x" << m.rows << ")";
+    throw core::InputError(s.str());
+  }
+}
+
+/// One gap's verdict for one pixel.
+struct GapResult {
+  bool velocity_known = false;
+  bool dangerous = false;
+  cv::Vec3d velocity;
+  double ttc = 0.0;
+};
+
+/// The per-pixel test of DESIGN 3.2 once the source position q and D_{i-k}(q) are known; the
+/// camera constants are hoisted out of the pixel loop (same maths as point_velocity).
+class PixelTest {
+ public:
+  PixelTest(const core::Camera& cam, const core::Envelope& env, const SceneFlowParams& p)
+      : fb_(cam.focal_px * cam.baseline_m),
+        inv_f_(1.0 / cam.focal_px),
+        cx_(cam.cx),
+        cy_(cam.cy),
+        max_speed2_(p.max_speed_mps * p.max_speed_mps),
+        env_(env),
+        p_(p) {}
+
+  GapResult operator()(float x, float y, float d_cur, cv::Point2f q, float d_prev,
+                       double span_s) const {
+    GapResult r;
+    if (!(d_prev > 0.0f)) return r;  // d_cur > 0 was checked by the caller
+    const double z = fb_ / d_cur, zp = fb_ / d_prev;
+    const cv::Vec3d P((x - cx_) * z * inv_f_, (y - cy_) * z * inv_f_, z);
+    const cv::Vec3d Pp((q.x - cx_) * zp * inv_f_, (q.y - cy_) * zp * inv_f_, zp);
+    r.velocity = (P - Pp) * (1.0 / span_s);
+    r.velocity_known = true;
+    if (z > p_.z_max_m || static_cast<double>(d_cur) - d_prev < p_.min_delta_d_px ||
+        r.velocity.dot(r.velocity) > max_speed2_)
+      return r;
+    r.dangerous = heads_into_envelope(P, r.velocity, env_, p_.v_min_mps, r.ttc);
+    return r;
+  }
+
+ private:
+  double fb_, inv_f_, cx_, cy_, max_speed2_;
+  const core::Envelope& env_;
+  const SceneFlowParams& p_;
+};
+
+}  // namespace
+
+std::vector<std::string> validate(const SceneFlowParams& p) {
+  std::vector<std::string> out;
+  auto require = [&out](bool ok, const char* field, auto value, const char* rule) {
+    if (ok) return;
+    std::ostringstream s;
+    s << "scene_flow." << field << "=" << value << ": " << rule;
+    out.push_back(s.str());
+  };
+  require(!p.gaps.empty(), "gaps", "[]", "must list at least one frame gap");
+  for (int k : p.gaps) require(k >= 1 && k <= 60, "gaps", k, "each gap must be in 1..60");
+  require(std::isfinite(p.v_min_mps) && p.v_min_mps > 0, "v_min_mps", p.v_min_mps, "must be > 0");
+  require(std::isfinite(p.z_max_m) && p.z_max_m > 0, "z_max_m", p.z_max_m, "must be > 0");
+  require(std::isfinite(p.min_delta_d_px) && p.min_delta_d_px >= 0, "min_delta_d_px",
+          p.min_delta_d_px, "must be >= 0");
+  require(p.max_speed_mps > p.v_min_mps, "max_speed_mps", p.max_speed_mps,
+          "must exceed v_min_mps");
+  require(p.max_disparity_step_px > 0, "max_disparity_step_px", p.max_disparity_step_px,
+          "must be > 0 (infinity disables)");
+  return out;
+}
+
+bool sample_disparity_bilinear(const cv::Mat& disp, float x, float y, float& out,
+                               float max_step) {
+  int x0, y0;
+  float fx, fy;
+  if (!split(x, disp.cols, x0, fx) || !split(y, disp.rows, y0, fy)) return false;
+  const float* r0 = disp.ptr<float>(y0) + x0;
+  const float* r1 = fy > 0.0f ? disp.ptr<float>(y0 + 1) + x0 : r0;
+  const float d00 = r0[0];
+  const float d01 = fx > 0.0f ? r0[1] : 0.0f;
+  const float d10 = fy > 0.0f ? r1[0] : 0.0f;
+  const float d11 = fx > 0.0f && fy > 0.0f ? r1[1] : 0.0f;
+  if (d00 < 0.0f || d01 < 0.0f || d10 < 0.0f || d11 < 0.0f) return false;
+  if (max_step < std::numeric_limits<float>::infinity()) {
+    // Unused neighbours stand in as d00 so that they do not widen the spread.
+    const float a = fx > 0.0f ? d01 : d00, b = fy > 0.0f ? d10 : d00;
+    const float c = fx > 0.0f && fy > 0.0f ? d11 : d00;
+    const float hi = std::max({d00, a, b, c}), lo = std::min({d00, a, b, c});
+    if (hi - lo > max_step) return false;
+  }
+  out = (1.0f - fy) * ((1.0f - fx) * d00 + fx * d01) + fy * ((1.0f - fx) * d10 + fx * d11);
+  return true;
+}
+
+bool sample_flow_bilinear(const cv::Mat& flow, float x, float y, cv::Vec2f& out) {
+  int x0, y0;
+  float fx, fy;
+  if (!split(x, flow.cols, x0, fx) || !split(y, flow.rows, y0, fy)) return false;
+  const float* r0 = flow.ptr<float>(y0) + 2 * x0;
+  const float* r1 = fy > 0.0f ? flow.ptr<float>(y0 + 1) + 2 * x0 : r0;
+  // Unused neighbours read as zero; a used non-finite one makes the sum non-finite.
+  float u = (1.0f - fx) * r0[0], v = (1.0f - fx) * r0[1];
+  if (fx > 0.0f) u += fx * r0[2], v += fx * r0[3];
+  if (fy > 0.0f) {
+    float u1 = (1.0f - fx) * r1[0], v1 = (1.0f - fx) * r1[1];
+    if (fx > 0.0f) u1 += fx * r1[2], v1 += fx * r1[3];
+    u = (1.0f - fy) * u + fy * u1;
+    v = (1.0f - fy) * v + fy * v1;
+  }
+  if (!std::isfinite(u) || !std::isfinite(v)) return false;
+  out = cv::Vec2f(u, v);
+  return true;
+}
+
+bool point_velocity(cv::Point2f p, float d_cur, cv::Point2f q, float d_prev,
+                    const core::Camera& camera, double dt, cv::Vec3d& velocity,
+                    cv::Point3d& position) {
+  if (!(d_cur > 0.0f) || !(d_prev > 0.0f) || !(dt > 0.0)) return false;
+  const cv::Point3d now = camera.point(p.x, p.y, d_cur);
+  const cv::Point3d before = camera.point(q.x, q.y, d_prev);
+  velocity = cv::Vec3d(now - before) / dt;
+  position = now;
+  return true;
+}
+
+bool heads_into_envelope(const cv::Point3d& P, const cv::Vec3d& V, const core::Envelope& e,
+                         double v_min, double& t_contact) {
+  if (!(V[2] <= -v_min)) return false;
+  const double t_c = (P.z - e.z_contact_m) / -V[2];
+  if (!(t_c > 0.0) || t_c > e.horizon_s) return false;
+  const double x = P.x + V[0] * t_c;
+  const double y = P.y + V[1] * t_c;
+  if (std::abs(x) > e.half_width_m || y < e.y_top_m || y > e.y_bottom_m) return false;
+  t_contact = t_c;
+  return true;
+}
+
+void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const cv::Mat& flow,
+                       const core::Camera& cam, const core::Envelope& env,
+                       const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
+                       cv::Mat& velocity) {
+  SceneFlowParams one = p;
+  one.gaps = {1};
+  label_stereo_flow_window(disp_cur, {&disp_prev}, {&flow}, cam, env, one, dt, danger, ttc,
+                           velocity);
+}
+
+void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const cv::Mat*>& past_disps,
+                              const std::vector<const cv::Mat*>& past_flows,
+                              const core::Camera& cam, const core::Envelope& env,
+                              const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
+                              cv::Mat& velocity) {
+  if (disp_cur.type() != CV_32FC1) throw core::InputError("scene flow: disparity must be CV_32F");
+  const int history = static_cast<int>(std::min(past_disps.size(), past_flows.size()));
+  for (int j = 0; j < history; ++j) {
+    check_same(disp_cur, *past_disps[j], CV_32FC1, "a past disparity");
+    check_same(disp_cur, *past_flows[j], CV_32FC2, "a flow");
+  }
+  // Gaps we can evaluate, ascending, without duplicates: the chain is walked once per pixel.
+  std::vector<int> gaps;
+  for (int k : p.gaps)
+    if (k >= 1 && k <= history) gaps.push_back(k);
+  std::sort(gaps.begin(), gaps.end());
+  gaps.erase(std::unique(gaps.begin(), gaps.end()), gaps.end());
+
+  danger.create(disp_cur.size(), CV_8UC1);
+  ttc.create(disp_cur.size(), CV_32FC1);
+  velocity.create(disp_cur.size(), CV_32FC3);
+  const cv::Vec3f unknown(kNaN, kNaN, kNaN);
+  const float max_step = static_cast<float>(p.max_disparity_step_px);
+  const PixelTest test(cam, env, p);
+
+  // Row by row, step-major: every pixel of the row advances its chain by one flow before the
+  // next step, so the independent chains overlap instead of waiting on one another.
+  std::vector<cv::Point2f> q(disp_cur.cols);
+  std::vector<uint8_t> alive(disp_cur.cols);
+  for (int y = 0; y < disp_cur.rows; ++y) {
+    const float* d_row = disp_cur.ptr<float>(y);
+    uint8_t* danger_row = danger.ptr<uint8_t>(y);
+    float* ttc_row = ttc.ptr<float>(y);
+    cv::Vec3f* vel_row = velocity.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < disp_cur.cols; ++x) {
+      danger_row[x] = 0;
+      ttc_row[x] = kNaN;
+      vel_row[x] = unknown;
+      q[x] = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
+      alive[x] = d_row[x] > 0.0f;
+    }
+    int step = 0;
+    for (int k : gaps) {
+      for (; step < k; ++step) {
+        const cv::Mat& flow = *past_flows[step];
+        for (int x = 0; x < disp_cur.cols; ++x) {
+          if (!alive[x]) continue;
+          cv::Vec2f f(0.0f, 0.0f);
+          // A point that left the image is lost for every longer gap too.
+          alive[x] = sample_flow_bilinear(flow, q[x].x, q[x].y, f);
+          q[x] += cv::Point2f(f[0], f[1]);
+        }
+      }
+      const cv::Mat& past = *past_disps[k - 1];
+      for (int x = 0; x < disp_cur.cols; ++x) {
+        float d_prev;
+        if (!alive[x] || !sample_disparity_bilinear(past, q[x].x, q[x].y, d_prev, max_step))
+          continue;
+        const GapResult r =
+            test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x], d_prev, k * dt);
+        if (!r.velocity_known) continue;
+        if (r.dangerous) {
+          if (danger_row[x] == 0 || r.ttc < ttc_row[x]) {
+            ttc_row[x] = static_cast<float>(r.ttc);
+            vel_row[x] = cv::Vec3f(r.velocity);
+          }
+          danger_row[x] = 255;
+        } else if (danger_row[x] == 0) {
+          vel_row[x] = cv::Vec3f(r.velocity);  // larger gaps come later: least noisy wins
+        }
+      }
+    }
+  }
+}
+
+GroundPlane fit_ground_plane(const cv::Mat& disp, const core::Camera& cam, const GroundParams& p) {
+  if (disp.type() != CV_32FC1) throw core::InputError("ground plane: disparity must be CV_32F");
+  std::vector<cv::Point3d> pts;
+  const int y0 = disp.rows - std::max(1, static_cast<int>(disp.rows * p.lower_fraction));
+  const int step = std::max(1, p.sample_step_px);
+  for (int y = y0; y < disp.rows; y += step) {
+    const float* row = disp.ptr<float>(y);
+    for (int x = 0; x < disp.cols; x += step) {
+      if (!(row[x] > 0.0f)) continue;
+      const cv::Point3d P = cam.point(x, y, row[x]);
+      if (P.z <= p.z_max_m) pts.push_back(P);
+    }
+  }
+  GroundPlane best;
+  if (pts.size() < 3) return best;
+  const double kMinUp = std::cos(CV_PI / 4);  // |n_y| >= cos 45 deg: roughly horizontal
+  auto count = [&pts, &p](const cv::Vec3d& n, double c) {
+    int inliers = 0;
+    for (const auto& P : pts)
+      if (std::abs(n.dot(cv::Vec3d(P)) + c) <= p.tolerance_m) ++inliers;
+    return inliers;
+  };
+  std::mt19937_64 rng(p.seed);
+  std::uniform_int_distribution<size_t> pick(0, pts.size() - 1);
+  for (int it = 0; it < p.iterations; ++it) {
+    const cv::Vec3d a(pts[pick(rng)]), b(pts[pick(rng)]), c(pts[pick(rng)]);
+    cv::Vec3d n = (b - a).cross(c - a);
+    const double len = cv::norm(n);
+    if (len < 1e-9) continue;
+    n /= len;
+    if (n[1] > 0) n = -n;  // point up (y down)
+    if (-n[1] < kMinUp) continue;
+    const int inliers = count(n, -n.dot(a));
+    if (inliers > best.inliers) best = {n, -n.dot(a), inliers, false};
+  }
+  if (best.inliers < std::max(3, p.min_inliers)) return GroundPlane{};
+  // Least-squares refit on the inliers: the normal is the smallest-eigenvalue direction.
+  cv::Vec3d mean(0, 0, 0);
+  std::vector<cv::Vec3d> in;
+  for (const auto& P : pts)
+    if (std::abs(best.normal.dot(cv::Vec3d(P)) + best.offset) <= p.tolerance_m) in.emplace_back(P);
+  for (const auto& P : in) mean += P;
+  mean /= static_cast<double>(in.size());
+  cv::Matx33d cov = cv::Matx33d::zeros();
+  for (const auto& P : in) cov += (P - mean) * (P - mean).t();
+  cv::Mat evals, evecs;
+  cv::eigen(cov, evals, evecs);  // descending eigenvalues
+  cv::Vec3d n(evecs.at<double>(2, 0), evecs.at<double>(2, 1), evecs.at<double>(2, 2));
+  if (n[1] > 0) n = -n;
+  if (-n[1] >= kMinUp) {
+    best.normal = n;
+    best.offset = -n.dot(mean);
+    best.inliers = count(best.normal, best.offset);
+  }
+  best.found = best.inliers >= p.min_inliers;
+  return best;
+}
+
+void mark_ground(const cv::Mat& disp, const core::Camera& cam, const GroundPlane& plane,
+                 double tolerance_m, cv::Mat& mask) {
+  if (disp.type() != CV_32FC1) throw core::InputError("ground mask: disparity must be CV_32F");
+  mask.create(disp.size(), CV_8UC1);
+  mask.setTo(0);
+  if (!plane.found) return;
+  for (int y = 0; y < disp.rows; ++y) {
+    const float* row = disp.ptr<float>(y);
+    uint8_t* out = mask.ptr<uint8_t>(y);
+    for (int x = 0; x < disp.cols; ++x) {
+      if (!(row[x] > 0.0f)) continue;
+      const cv::Point3d P = cam.point(x, y, row[x]);
+      if (plane.normal.dot(cv::Vec3d(P)) + plane.offset <= tolerance_m) out[x] = 255;
+    }
+  }
+}
+
+}  // namespace sg::vision

@@ -1,0 +1,179 @@
+#include "sg/vision/signals.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+
+namespace sg::vision {
+namespace {
+
+/// Median of `v` (reordered); the mean of the two middle values for an even count.
+double median_of(std::vector<double>& v) {
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  const double upper = v[mid];
+  if (v.size() % 2 == 1) return upper;
+  const double lower = *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid));
+  return 0.5 * (lower + upper);
+}
+
+struct Blob {
+  cv::Point first{-1, -1};  ///< first pixel in raster order
+  std::vector<double> depths;
+  std::vector<double> ttcs;
+};
+
+}  // namespace
+
+std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp,
+                                              const cv::Mat& ttc, const core::Camera& camera,
+                                              const core::SignalParams& p) {
+  if (p.open_size > 1) {
+    const cv::Mat kernel =
+        cv::getStructuringElement(cv::MORPH_RECT, cv::Size(p.open_size, p.open_size));
+    cv::morphologyEx(mask, mask, cv::MORPH_OPEN, kernel);
+  }
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+
+  std::vector<Blob> blobs(static_cast<size_t>(count));
+  auto kept = [&](int label) { return stats.at<int>(label, cv::CC_STAT_AREA) >= p.min_area_px; };
+  for (int y = 0; y < mask.rows; ++y) {
+    const int* lab = labels.ptr<int>(y);
+    const float* d = disp.ptr<float>(y);
+    const float* t = ttc.ptr<float>(y);
+    uchar* m = mask.ptr<uchar>(y);
+    for (int x = 0; x < mask.cols; ++x) {
+      const int l = lab[x];
+      if (l == 0) continue;
+      if (!kept(l)) {
+        m[x] = 0;
+        continue;
+      }
+      Blob& b = blobs[static_cast<size_t>(l)];
+      if (b.first.x < 0) b.first = {x, y};
+      if (d[x] > 0.0f) b.depths.push_back(camera.depth(d[x]));
+      if (std::isfinite(t[x])) b.ttcs.push_back(t[x]);
+    }
+  }
+
+  // connectedComponents numbers blobs in its own scan order (block-based); sort by first pixel.
+  std::vector<int> order;
+  for (int l = 1; l < count; ++l)
+    if (kept(l)) order.push_back(l);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    const cv::Point pa = blobs[static_cast<size_t>(a)].first;
+    const cv::Point pb = blobs[static_cast<size_t>(b)].first;
+    return pa.y != pb.y ? pa.y < pb.y : pa.x < pb.x;
+  });
+
+  std::vector<core::Obstacle> out;
+  out.reserve(order.size());
+  for (int l : order) {
+    Blob& b = blobs[static_cast<size_t>(l)];
+    core::Obstacle o;
+    o.bbox = cv::Rect(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
+                      stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT));
+    o.pixels = stats.at<int>(l, cv::CC_STAT_AREA);
+    o.distance_m = b.depths.empty() ? 0.0 : median_of(b.depths);
+    if (!b.ttcs.empty()) o.ttc_s = median_of(b.ttcs);
+    out.push_back(o);
+  }
+  return out;
+}
+
+std::vector<std::string> region_names(int columns) {
+  if (columns == 3) return {"left", "centre", "right"};
+  std::vector<std::string> names;
+  for (int i = 0; i < columns; ++i) {
+    std::string name = "r";  // not "r" + ...: GCC 12 warns falsely (-Wrestrict, PR 105329)
+    name += std::to_string(i);
+    names.push_back(name);
+  }
+  return names;
+}
+
+std::vector<int> count_region_pixels(const cv::Mat& mask, int columns) {
+  std::vector<int> counts(static_cast<size_t>(columns), 0);
+  for (int c = 0; c < columns; ++c) {
+    const int x0 = c * mask.cols / columns;
+    const int x1 = (c + 1) * mask.cols / columns;
+    if (x1 > x0)
+      counts[static_cast<size_t>(c)] = cv::countNonZero(mask.colRange(x0, x1));
+  }
+  return counts;
+}
+
+RegionHysteresis::RegionHysteresis(const core::SignalParams& p) : p_(p) {}
+
+std::vector<core::RegionSignal> RegionHysteresis::update(const std::vector<int>& region_pixels) {
+  const size_t n = region_pixels.size();
+  if (history_.size() != n) {  // first frame (or a new grid): start clear
+    history_.assign(n, {});
+    clear_run_.assign(n, 0);
+    on_.assign(n, false);
+  }
+  const std::vector<std::string> names = region_names(static_cast<int>(n));
+  std::vector<core::RegionSignal> out(n);
+  for (size_t r = 0; r < n; ++r) {
+    const bool dangerous = region_pixels[r] > p_.region_min_px;
+    std::deque<bool>& h = history_[r];
+    h.push_back(dangerous);
+    while (static_cast<int>(h.size()) > p_.on_n) h.pop_front();
+    clear_run_[r] = dangerous ? 0 : clear_run_[r] + 1;
+    if (!on_[r]) {
+      if (std::count(h.begin(), h.end(), true) >= p_.on_k) on_[r] = true;
+    } else if (clear_run_[r] >= p_.off_m) {
+      on_[r] = false;
+      h.clear();  // so that old dangerous frames cannot turn it straight back on
+    }
+    out[r] = {names[r], on_[r], region_pixels[r]};
+  }
+  return out;
+}
+
+core::Severity severity_of(bool signal, const std::vector<core::Obstacle>& obstacles,
+                           const core::SignalParams& p) {
+  if (!signal) return core::Severity::kNone;
+  double min_ttc = std::numeric_limits<double>::infinity();
+  bool any = false;
+  for (const core::Obstacle& o : obstacles) {
+    if (!o.ttc_s) continue;
+    any = true;
+    min_ttc = std::min(min_ttc, *o.ttc_s);
+  }
+  // A signal held on by hysteresis over a frame without obstacles is still a warning.
+  if (!any) return core::Severity::kWarning;
+  if (min_ttc <= p.ttc_danger_s) return core::Severity::kDanger;
+  if (min_ttc <= p.ttc_warning_s) return core::Severity::kWarning;
+  return core::Severity::kNone;
+}
+
+core::Steering steering_hint(const std::vector<core::RegionSignal>& regions) {
+  const int n = static_cast<int>(regions.size());
+  const bool any_fired = std::any_of(regions.begin(), regions.end(),
+                                     [](const core::RegionSignal& r) { return r.fired; });
+  if (!any_fired) return core::Steering::kStraight;
+  // The centre-most clear column wins; among equally central ones the one with fewer dangerous
+  // pixels, then the left one. Positions are doubled so that the centre (n - 1) / 2 is integral.
+  int best = -1;
+  for (int c = 0; c < n; ++c) {
+    if (regions[static_cast<size_t>(c)].fired) continue;
+    if (best < 0) {
+      best = c;
+      continue;
+    }
+    const int dc = std::abs(2 * c - (n - 1));
+    const int db = std::abs(2 * best - (n - 1));
+    if (dc < db || (dc == db && regions[static_cast<size_t>(c)].dangerous_px <
+                                    regions[static_cast<size_t>(best)].dangerous_px))
+      best = c;
+  }
+  if (best < 0) return core::Steering::kStop;
+  const int side = 2 * best - (n - 1);
+  if (side == 0) return core::Steering::kStraight;
+  return side < 0 ? core::Steering::kLeft : core::Steering::kRight;
+}
+
+}  // namespace sg::vision

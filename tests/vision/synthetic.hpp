@@ -1,0 +1,63 @@
+#pragma once
+/// Synthetic inputs for the vision tests: textured stereo pairs with known disparity.
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace sg::vision::test {
+
+/// Smooth random texture (blurred uniform noise, full 0..255 range), fixed seed.
+inline cv::Mat texture(cv::Size size, uint64_t seed, double sigma = 1.0) {
+  cv::RNG rng(seed);
+  cv::Mat noise(size, CV_8U);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat smooth;
+  cv::GaussianBlur(noise, smooth, cv::Size(0, 0), sigma);
+  cv::normalize(smooth, smooth, 0, 255, cv::NORM_MINMAX);
+  return smooth;
+}
+
+/// A rectified pair where every left pixel (x, y) matches right pixel (x - d, y): the right image
+/// is the left texture sampled at x + d (bilinear for fractional d).
+struct StereoPair {
+  cv::Mat left, right;
+};
+
+inline StereoPair shifted_pair(cv::Size size, float d, uint64_t seed) {
+  const int margin = static_cast<int>(d) + 4;
+  cv::Mat wide = texture({size.width + margin, size.height}, seed, 1.2);
+  cv::Mat map_x(size, CV_32F), map_y(size, CV_32F);
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) {
+      map_x.at<float>(y, x) = static_cast<float>(x) + d;
+      map_y.at<float>(y, x) = static_cast<float>(y);
+    }
+  StereoPair p;
+  p.left = wide(cv::Rect(0, 0, size.width, size.height)).clone();
+  cv::remap(wide, p.right, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  return p;
+}
+
+/// A scene with structure: background at disparity 6, a nearer box at 21, a slanted strip, and a
+/// flat (textureless) patch, so that BM output mixes valid, invalid and occluded pixels.
+inline StereoPair scene_pair(cv::Size size, uint64_t seed) {
+  cv::Mat tex = texture({size.width + 64, size.height}, seed, 1.0);
+  cv::Mat flat = tex.clone();
+  flat(cv::Rect(size.width / 2, size.height / 5, size.width / 6, size.height / 4)).setTo(128);
+  cv::Mat map_x(size, CV_32F), map_y(size, CV_32F);
+  const cv::Rect box(size.width / 5, size.height / 3, size.width / 4, size.height / 3);
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) {
+      float d = 6.0f;
+      if (box.contains({x, y})) d = 21.0f;
+      if (x > 3 * size.width / 4) d = 6.0f + 10.0f * static_cast<float>(y) / size.height;
+      // Right pixel x shows the left texture at x + d.
+      map_x.at<float>(y, x) = static_cast<float>(x) + d;
+      map_y.at<float>(y, x) = static_cast<float>(y);
+    }
+  StereoPair p;
+  p.left = flat(cv::Rect(0, 0, size.width, size.height)).clone();
+  cv::remap(flat, p.right, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  return p;
+}
+
+}  // namespace sg::vision::test

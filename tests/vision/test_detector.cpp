@@ -1,0 +1,161 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sg/core/error.hpp"
+#include "sg/vision/detector.hpp"
+#include "synthetic.hpp"
+
+namespace sg::vision {
+namespace {
+
+/// f*B = 50 px*m, 10 fps, 161 x 121.
+core::Camera camera() {
+  core::Camera c;
+  c.width = 161;
+  c.height = 121;
+  c.focal_px = 100.0;
+  c.baseline_m = 0.5;
+  c.cx = 80.0;
+  c.cy = 60.0;
+  c.fps = 10.0;
+  return c;
+}
+
+const cv::Rect kPatch(60, 45, 60, 31);  // centre columns [53,107) and 13 columns of the right
+
+/// Background at 25 m (beyond z_max) with a patch at depth z, quantized to 1/16 px like BM, and
+/// uniform noise of up to `noise` px on every valid pixel.
+cv::Mat scene(double z, cv::RNG& rng, double noise = 0.0) {
+  const core::Camera cam = camera();
+  cv::Mat d(cam.height, cam.width, CV_32F, cv::Scalar(cam.disparity(25.0)));
+  d(kPatch).setTo(cam.disparity(z));
+  d(cv::Rect(0, 0, 20, 121)).setTo(-1.0f);  // BM's dead band on the left
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x) {
+      float& v = d.at<float>(y, x);
+      if (v < 0) continue;
+      v = std::round((v + static_cast<float>(rng.uniform(-noise, noise))) * 16.0f) / 16.0f;
+    }
+  return d;
+}
+
+core::StereoFrame frame(int i) {
+  core::StereoFrame f;
+  f.index = i;
+  f.time_s = i / camera().fps;
+  return f;
+}
+
+TEST(Detector, ApproachingPatchFiresAfterHysteresisInItsRegions) {
+  const core::DetectorParams params;  // defaults
+  Detector det(params, camera());
+  cv::RNG rng(5);
+  std::vector<core::Detection> out;
+  for (int i = 0; i < 24; ++i) {
+    const double z = 8.0 - 0.25 * i;  // 2.5 m/s towards the camera
+    out.push_back(det.process(frame(i), {scene(z, rng, 0.1), {}}));
+  }
+  EXPECT_EQ(out[0].frame, 0);
+  EXPECT_EQ(out[5].frame, 5);
+  EXPECT_DOUBLE_EQ(out[5].time_s, 0.5);
+  EXPECT_EQ(cv::countNonZero(out[0].danger), 0);  // no history yet
+
+  int first_dangerous = -1;
+  for (int i = 0; i < 24 && first_dangerous < 0; ++i)
+    if (out[i].regions.size() == 3 && out[i].regions[1].dangerous_px > params.signal.region_min_px)
+      first_dangerous = i;
+  // TTC = Z / v <= 3 s from Z = 7.5 m (frame 2), needing D_i - D_{i-k} >= 1 px: gap 5 first
+  // reaches it at frame 5 (8 m -> 6.75 m: 1.16 px).
+  ASSERT_GE(first_dangerous, 2);
+  ASSERT_LE(first_dangerous, 6);
+  const int first_signal = first_dangerous + params.signal.on_k - 1;
+  for (int i = 0; i < first_signal; ++i) EXPECT_FALSE(out[i].signal) << "frame " << i;
+  for (int i = first_signal; i < 24; ++i) {
+    const core::Detection& d = out[i];
+    EXPECT_TRUE(d.signal) << "frame " << i;
+    ASSERT_EQ(d.regions.size(), 3u);
+    EXPECT_FALSE(d.regions[0].fired);
+    EXPECT_TRUE(d.regions[1].fired);
+    EXPECT_TRUE(d.regions[2].fired);
+    EXPECT_EQ(d.steering, core::Steering::kLeft) << "frame " << i;
+    ASSERT_EQ(d.obstacles.size(), 1u) << "frame " << i;
+    EXPECT_EQ(d.obstacles[0].bbox, kPatch);
+    const double z = 8.0 - 0.25 * i;
+    EXPECT_NEAR(d.obstacles[0].distance_m, z, 0.05 * z);
+    ASSERT_TRUE(d.obstacles[0].ttc_s.has_value());
+    EXPECT_NEAR(*d.obstacles[0].ttc_s, z / 2.5, 0.25 * z / 2.5) << "frame " << i;
+    EXPECT_EQ(d.danger.type(), CV_8UC1);
+  }
+  EXPECT_EQ(out[first_signal].severity, core::Severity::kWarning);
+  EXPECT_EQ(out[23].severity, core::Severity::kDanger);  // Z = 2.25 m, TTC 0.9 s
+}
+
+TEST(Detector, StaticAndRecedingScenesNeverFire) {
+  const core::DetectorParams params;
+  for (double speed : {0.0, -2.5}) {
+    Detector det(params, camera());
+    cv::RNG rng(6);
+    for (int i = 0; i < 40; ++i) {
+      const double z = 3.0 - speed * 0.1 * i;  // static at 3 m, or receding from 3 m
+      const core::Detection d = det.process(frame(i), {scene(z, rng, 0.15), {}});
+      EXPECT_FALSE(d.signal) << "speed " << speed << " frame " << i;
+      EXPECT_EQ(cv::countNonZero(d.danger), 0) << "speed " << speed << " frame " << i;
+      EXPECT_EQ(d.severity, core::Severity::kNone);
+      EXPECT_EQ(d.steering, core::Steering::kStraight);
+    }
+  }
+}
+
+TEST(Detector, GapUsesTheFrameExactlyKFramesAgo) {
+  core::DetectorParams params;
+  params.stereo.gaps = {3};
+  params.signal.on_k = 1;
+  params.signal.on_n = 1;
+  Detector det(params, camera());
+  const core::Camera cam = camera();
+  std::vector<core::Detection> out;
+  // Patch disparity 9, 10, 11, 12 px over frames 0..3 (Z 5.6 -> 4.2 m).
+  for (int i = 0; i < 4; ++i) {
+    cv::Mat d(cam.height, cam.width, CV_32F, cv::Scalar(-1.0f));
+    d(kPatch).setTo(9.0f + i);
+    out.push_back(det.process(frame(i), {d, {}}));
+  }
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(out[i].signal) << "frame " << i;  // no D_{i-3} yet
+  ASSERT_TRUE(out[3].signal);
+  ASSERT_EQ(out[3].obstacles.size(), 1u);
+  // Against frame 0: 0.3 s * 9 / 3 = 0.9 s to the camera (frame 1 would give 1.5 s, frame 2
+  // 3.3 s), scaled to the time to reach the contact depth: Z = 50 / 12 m, contact at 0.5 m.
+  const double z = 50.0 / 12.0;
+  EXPECT_NEAR(*out[3].obstacles[0].ttc_s, 0.9 * (z - 0.5) / z, 1e-6);
+}
+
+TEST(Detector, StereoFlowModeIsNotAvailableYet) {
+  core::DetectorParams params;
+  params.mode = core::Mode::kStereoFlow;
+  EXPECT_THROW(Detector(params, camera()), core::InputError);
+}
+
+TEST(Detector, DisparitySizeChangeIsAnInputError) {
+  Detector det(core::DetectorParams{}, camera());
+  det.process(frame(0), {cv::Mat(121, 161, CV_32F, cv::Scalar(5.0f)), {}});
+  EXPECT_THROW(det.process(frame(1), {cv::Mat(120, 161, CV_32F, cv::Scalar(5.0f)), {}}),
+               core::InputError);
+}
+
+TEST(ComputeDisparity, MatchesBmAndRejectsMismatchedFrames) {
+  const auto pair = test::shifted_pair({201, 97}, 9.0f, 21);
+  core::StereoFrame f = frame(0);
+  f.left = pair.left;
+  f.right = pair.right;
+  core::DetectorParams params;
+  cv::Mat disp;
+  compute_disparity(f, params, disp);
+  ASSERT_EQ(disp.size(), pair.left.size());
+  EXPECT_NEAR(disp.at<float>(48, 150), 9.0f, 0.25f);
+  f.right = pair.right(cv::Rect(0, 0, 200, 97));
+  EXPECT_THROW(compute_disparity(f, params, disp), core::InputError);
+}
+
+}  // namespace
+}  // namespace sg::vision

@@ -1,0 +1,566 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "sg/core/error.hpp"
+#include "sg/vision/scene_flow.hpp"
+
+namespace sg::vision {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Bilinear sampling
+
+/// 5 x 4 map, d(x, y) = 10 y + x, with (2, 1) invalid.
+cv::Mat hand_map() {
+  cv::Mat d(4, 5, CV_32F);
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x) d.at<float>(y, x) = static_cast<float>(10 * y + x);
+  d.at<float>(1, 2) = -1.0f;
+  return d;
+}
+
+TEST(SampleDisparity, ExactBilinearValue) {
+  const cv::Mat d = hand_map();
+  float v = 0;
+  // Cell (3..4, 1..2): 13, 14, 23, 24 weighted (0.75, 0.25) in x and (0.5, 0.5) in y.
+  ASSERT_TRUE(sample_disparity_bilinear(d, 3.25f, 1.5f, v));
+  EXPECT_FLOAT_EQ(v, 0.5f * (0.75f * 13 + 0.25f * 14) + 0.5f * (0.75f * 23 + 0.25f * 24));
+  ASSERT_TRUE(sample_disparity_bilinear(d, 0.5f, 2.25f, v));
+  EXPECT_FLOAT_EQ(v, 0.75f * (0.5f * 20 + 0.5f * 21) + 0.25f * (0.5f * 30 + 0.5f * 31));
+  ASSERT_TRUE(sample_disparity_bilinear(d, 4.0f, 3.0f, v));
+  EXPECT_FLOAT_EQ(v, 34.0f);
+}
+
+TEST(SampleDisparity, InvalidNeighbourUsedFails) {
+  const cv::Mat d = hand_map();
+  float v = -7;
+  // Each of the four cells around the invalid (2, 1) uses it.
+  EXPECT_FALSE(sample_disparity_bilinear(d, 1.5f, 0.5f, v));  // as bottom-right neighbour
+  EXPECT_FALSE(sample_disparity_bilinear(d, 2.5f, 0.5f, v));  // bottom-left
+  EXPECT_FALSE(sample_disparity_bilinear(d, 1.5f, 1.5f, v));  // top-right
+  EXPECT_FALSE(sample_disparity_bilinear(d, 2.5f, 1.5f, v));  // top-left
+  EXPECT_FALSE(sample_disparity_bilinear(d, 2.0f, 1.0f, v));  // on it
+  EXPECT_EQ(v, -7);                                           // untouched on failure
+  // Zero-weight neighbours are not used: on column 1 or row 0 the invalid pixel is not read.
+  ASSERT_TRUE(sample_disparity_bilinear(d, 1.0f, 1.5f, v));
+  EXPECT_FLOAT_EQ(v, 16.0f);
+  ASSERT_TRUE(sample_disparity_bilinear(d, 2.5f, 0.0f, v));
+  EXPECT_FLOAT_EQ(v, 2.5f);
+  ASSERT_TRUE(sample_disparity_bilinear(d, 2.0f, 2.5f, v));
+  EXPECT_FLOAT_EQ(v, 27.0f);
+}
+
+TEST(SampleDisparity, OutsideTheImageFails) {
+  const cv::Mat d = hand_map();
+  const float w1 = 4.0f, h1 = 3.0f;
+  const float eps = 1e-3f;
+  float v = 0;
+  // The four corners are inside ...
+  EXPECT_TRUE(sample_disparity_bilinear(d, 0.0f, 0.0f, v));
+  EXPECT_TRUE(sample_disparity_bilinear(d, w1, 0.0f, v));
+  EXPECT_TRUE(sample_disparity_bilinear(d, 0.0f, h1, v));
+  EXPECT_TRUE(sample_disparity_bilinear(d, w1, h1, v));
+  // ... and a step past each side of each corner is outside.
+  for (auto [x, y] : {std::pair{-eps, 0.0f}, {0.0f, -eps}, {w1 + eps, 0.0f}, {w1, -eps},
+                      {-eps, h1}, {0.0f, h1 + eps}, {w1 + eps, h1}, {w1, h1 + eps}})
+    EXPECT_FALSE(sample_disparity_bilinear(d, x, y, v)) << x << "," << y;
+  EXPECT_FALSE(sample_disparity_bilinear(d, NAN, 1.0f, v));
+  EXPECT_FALSE(sample_disparity_bilinear(d, 1.0f, INFINITY, v));
+}
+
+TEST(SampleDisparity, DepthEdgeFailsWithMaxStep) {
+  cv::Mat d(3, 4, CV_32F, cv::Scalar(5.0f));
+  d.at<float>(1, 2) = 7.0f;
+  float v = 0;
+  EXPECT_TRUE(sample_disparity_bilinear(d, 1.5f, 0.5f, v));         // no limit by default
+  EXPECT_FALSE(sample_disparity_bilinear(d, 1.5f, 0.5f, v, 1.5f));  // spread 2 > 1.5
+  EXPECT_TRUE(sample_disparity_bilinear(d, 1.5f, 0.5f, v, 2.0f));
+  EXPECT_TRUE(sample_disparity_bilinear(d, 1.0f, 0.5f, v, 0.5f));   // (2, 1) unused
+  EXPECT_FLOAT_EQ(v, 5.0f);
+}
+
+TEST(SampleFlow, BilinearAndInvalid) {
+  cv::Mat f(3, 4, CV_32FC2);
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 4; ++x) f.at<cv::Vec2f>(y, x) = cv::Vec2f(x * 2.0f, -y * 3.0f);
+  cv::Vec2f v;
+  ASSERT_TRUE(sample_flow_bilinear(f, 1.25f, 0.5f, v));
+  EXPECT_FLOAT_EQ(v[0], 2.5f);
+  EXPECT_FLOAT_EQ(v[1], -1.5f);
+  f.at<cv::Vec2f>(1, 2)[1] = NAN;
+  EXPECT_FALSE(sample_flow_bilinear(f, 1.5f, 0.5f, v));
+  EXPECT_TRUE(sample_flow_bilinear(f, 1.0f, 0.5f, v));
+  EXPECT_FALSE(sample_flow_bilinear(f, 3.01f, 0.0f, v));
+}
+
+// ---------------------------------------------------------------------------------------------
+// 3D velocity and the envelope test
+
+core::Camera odd_camera() {
+  core::Camera c;
+  c.width = 151;
+  c.height = 117;
+  c.focal_px = 200.0;
+  c.baseline_m = 0.1;
+  c.cx = 74.3;
+  c.cy = 57.8;
+  return c;
+}
+
+TEST(PointVelocity, RecoversAKnownMotion) {
+  const core::Camera cam = odd_camera();
+  const double dt = 0.1;
+  const cv::Point3d before(0.4, -0.2, 5.0);
+  const cv::Vec3d truth(-0.3, 0.1, -2.0);
+  const cv::Point3d now = before + cv::Point3d(truth * dt);
+  // Pixels and disparities exactly as a camera would see them (then rounded to float).
+  const cv::Point2d p = cam.project(now), q = cam.project(before);
+  const float d_cur = static_cast<float>(cam.focal_px * cam.baseline_m / now.z);
+  const float d_prev = static_cast<float>(cam.focal_px * cam.baseline_m / before.z);
+  cv::Vec3d v;
+  cv::Point3d pos;
+  ASSERT_TRUE(point_velocity(cv::Point2f(p), d_cur, cv::Point2f(q), d_prev, cam, dt, v, pos));
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(v[i], truth[i], 2e-4) << i;  // float pixels, /dt
+  EXPECT_NEAR(pos.x, now.x, 1e-5);
+  EXPECT_NEAR(pos.y, now.y, 1e-5);
+  EXPECT_NEAR(pos.z, now.z, 1e-5);
+  EXPECT_FALSE(point_velocity(cv::Point2f(p), 0.0f, cv::Point2f(q), d_prev, cam, dt, v, pos));
+  EXPECT_FALSE(point_velocity(cv::Point2f(p), d_cur, cv::Point2f(q), -1.0f, cam, dt, v, pos));
+  EXPECT_FALSE(point_velocity(cv::Point2f(p), d_cur, cv::Point2f(q), d_prev, cam, 0.0, v, pos));
+}
+
+// Default envelope: |X| <= 0.5, -1 <= Y <= 1, z_contact 0.5 m, horizon 3 s.
+TEST(HeadsIntoEnvelope, HandComputedCases) {
+  const core::Envelope e;
+  const double v_min = 0.3;
+  double t = -1;
+  // Straight in: t_c = (4.5 - 0.5) / 2 = 2 s at (0.2, 0.3).
+  EXPECT_TRUE(heads_into_envelope({0.2, 0.3, 4.5}, {0, 0, -2}, e, v_min, t));
+  EXPECT_DOUBLE_EQ(t, 2.0);
+  // From the side into it: t_c = 3 / 1.5 = 2 s, X(2) = 1.0 - 0.8 = 0.2.
+  EXPECT_TRUE(heads_into_envelope({1.0, 0.0, 3.5}, {-0.4, 0, -1.5}, e, v_min, t));
+  EXPECT_DOUBLE_EQ(t, 2.0);
+  t = -1;
+  // Passing beside: X stays 1.0; crossing through: X(2) = -0.2 + 1.0 = 0.8.
+  EXPECT_FALSE(heads_into_envelope({1.0, 0.0, 3.5}, {0, 0, -1.5}, e, v_min, t));
+  EXPECT_FALSE(heads_into_envelope({-0.2, 0.0, 3.5}, {0.5, 0, -1.5}, e, v_min, t));
+  // Ground below the envelope (ego motion towards it): Y = 1.3 > y_bottom.
+  EXPECT_FALSE(heads_into_envelope({0.0, 1.3, 2.5}, {0, 0, -1}, e, v_min, t));
+  // Overhead: Y = -1.2 < y_top.
+  EXPECT_FALSE(heads_into_envelope({0.0, -1.2, 2.5}, {0, 0, -1}, e, v_min, t));
+  // Receding.
+  EXPECT_FALSE(heads_into_envelope({0.0, 0.0, 2.5}, {0, 0, 1}, e, v_min, t));
+  // Slow: |V_z| = 0.2 < v_min although t_c = 0.3 / 0.2 = 1.5 s is within the horizon.
+  EXPECT_FALSE(heads_into_envelope({0.0, 0.0, 0.8}, {0, 0, -0.2}, e, v_min, t));
+  EXPECT_TRUE(heads_into_envelope({0.0, 0.0, 0.8}, {0, 0, -0.2}, e, 0.1, t));
+  EXPECT_DOUBLE_EQ(t, 1.5);
+  // Beyond the horizon: t_c = 8 / 2 = 4 s > 3 s; a 5 s horizon catches it.
+  EXPECT_FALSE(heads_into_envelope({0.0, 0.0, 8.5}, {0, 0, -2}, e, v_min, t));
+  core::Envelope longer = e;
+  longer.horizon_s = 5.0;
+  EXPECT_TRUE(heads_into_envelope({0.0, 0.0, 8.5}, {0, 0, -2}, longer, v_min, t));
+  EXPECT_DOUBLE_EQ(t, 4.0);
+  // Already closer than z_contact: t_c <= 0 is not a future contact.
+  EXPECT_FALSE(heads_into_envelope({0.0, 0.0, 0.4}, {0, 0, -2}, e, v_min, t));
+}
+
+TEST(SceneFlowParams, Validate) {
+  EXPECT_TRUE(validate(SceneFlowParams{}).empty());
+  SceneFlowParams p;
+  p.gaps = {1, 0};
+  p.v_min_mps = -1;
+  const auto problems = validate(p);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_NE(problems[0].find("scene_flow.gaps=0"), std::string::npos);
+  EXPECT_NE(problems[1].find("scene_flow.v_min_mps=-1"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Labelling on synthetic maps
+
+constexpr double kDt = 1.0 / 30.0;
+
+/// Background: a wall at 20 m (d = 1 px for f B = 20), flow zero.
+struct Maps {
+  cv::Mat cur, prev, flow;
+};
+Maps wall(const core::Camera& cam) {
+  Maps m;
+  m.cur = cv::Mat(cam.height, cam.width, CV_32F, cv::Scalar(1.0f));
+  m.prev = m.cur.clone();
+  m.flow = cv::Mat(cam.height, cam.width, CV_32FC2, cv::Scalar(0, 0));
+  return m;
+}
+
+TEST(LabelStereoFlow, HeadOnPatchIsDangerous) {
+  const core::Camera cam = odd_camera();  // f B = 20
+  Maps m = wall(cam);
+  const cv::Rect patch(60, 45, 31, 27);
+  // 2.0 m -> 1.9 m in one frame: V_z = -3 m/s, straight along the rays (flow zero).
+  m.prev(patch).setTo(20.0 / 2.0);
+  m.cur(patch).setTo(20.0 / 1.9);
+  cv::Mat danger, ttc, vel;
+  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, {}, kDt, danger, ttc, vel);
+  ASSERT_EQ(danger.type(), CV_8UC1);
+  ASSERT_EQ(ttc.type(), CV_32FC1);
+  ASSERT_EQ(vel.type(), CV_32FC3);
+  EXPECT_EQ(cv::countNonZero(danger(patch)), patch.area());
+  EXPECT_EQ(cv::countNonZero(danger), patch.area());
+  const double z_now = 20.0 / static_cast<float>(20.0 / 1.9);
+  const double z_before = 20.0 / static_cast<float>(20.0 / 2.0);
+  const double vz = (z_now - z_before) / kDt;
+  EXPECT_NEAR(vz, -3.0, 1e-3);
+  const cv::Point c(75, 58);
+  EXPECT_NEAR(ttc.at<float>(c), (z_now - 0.5) / -vz, 1e-4);
+  EXPECT_NEAR(vel.at<cv::Vec3f>(c)[2], vz, 1e-3);
+  // The wall is static: velocity known and zero, TTC NaN.
+  EXPECT_TRUE(std::isnan(ttc.at<float>(5, 5)));
+  EXPECT_NEAR(cv::norm(vel.at<cv::Vec3f>(5, 5)), 0.0, 1e-6);
+}
+
+// The point of the mode: a patch moving sideways at constant depth changes the disparity at fixed
+// pixels along its edges (Stereo mode flags them) but its 3D motion does not approach.
+TEST(LabelStereoFlow, CrossingPatchIsSafeEvenAtItsEdges) {
+  const core::Camera cam = odd_camera();
+  Maps m = wall(cam);
+  const int shift = 6;
+  const cv::Rect before(30, 40, 30, 31), now = before + cv::Point(shift, 0);
+  m.prev(before).setTo(10.0);  // 2 m
+  m.cur(now).setTo(10.0);
+  m.flow(now).setTo(cv::Scalar(-shift, 0));
+  const cv::Point leading_edge(now.br().x - 2, now.y + 10);
+  ASSERT_GE(m.cur.at<float>(leading_edge) - m.prev.at<float>(leading_edge), 0.5f);
+  cv::Mat danger, ttc, vel;
+  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, {}, kDt, danger, ttc, vel);
+  EXPECT_EQ(cv::countNonZero(danger), 0);
+  const cv::Vec3f v = vel.at<cv::Vec3f>(leading_edge);
+  EXPECT_NEAR(v[0], shift * 2.0 / cam.focal_px / kDt, 1e-3);  // 1.8 m/s sideways
+  EXPECT_NEAR(v[2], 0.0, 1e-4);
+}
+
+TEST(LabelStereoFlow, UnknownWhereTheFlowLeavesTheImage) {
+  const core::Camera cam = odd_camera();
+  Maps m = wall(cam);
+  m.flow.setTo(cv::Scalar(-3, 0));
+  m.cur.at<float>(10, 20) = -1.0f;
+  cv::Mat danger, ttc, vel;
+  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, {}, kDt, danger, ttc, vel);
+  EXPECT_TRUE(std::isnan(vel.at<cv::Vec3f>(10, 2)[0]));   // q.x = -1
+  EXPECT_FALSE(std::isnan(vel.at<cv::Vec3f>(10, 3)[0]));  // q.x = 0
+  EXPECT_TRUE(std::isnan(vel.at<cv::Vec3f>(10, 20)[2]));  // D_i invalid
+  EXPECT_THROW(label_stereo_flow(m.cur, m.prev(cv::Rect(0, 0, 10, 10)), m.flow, cam, {}, {}, kDt,
+                                 danger, ttc, vel),
+               core::InputError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Naive reference: written from DESIGN 3.2 with at<>() and double arithmetic, sharing nothing
+// with the implementation.
+
+bool naive_sample(const cv::Mat& m, int channel, double x, double y, double& out,
+                  double max_step = INFINITY) {
+  if (!(x >= 0 && y >= 0 && x <= m.cols - 1 && y <= m.rows - 1)) return false;
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  const double fx = x - x0, fy = y - y0;
+  double sum = 0, lo = INFINITY, hi = -INFINITY;
+  for (int dy = 0; dy < 2; ++dy)
+    for (int dx = 0; dx < 2; ++dx) {
+      const double w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy);
+      if (w == 0) continue;
+      const float v = m.channels() == 1 ? m.at<float>(y0 + dy, x0 + dx)
+                                        : m.at<cv::Vec2f>(y0 + dy, x0 + dx)[channel];
+      if (m.channels() == 1 ? !(v >= 0) : !std::isfinite(v)) return false;
+      sum += w * v;
+      lo = std::min<double>(lo, v);
+      hi = std::max<double>(hi, v);
+    }
+  if (hi - lo > max_step) return false;
+  out = sum;
+  return true;
+}
+
+struct NaiveOut {
+  bool danger = false;
+  double ttc = NAN;
+  cv::Vec3d vel{NAN, NAN, NAN};
+};
+
+NaiveOut naive_pixel(int x, int y, const cv::Mat& cur, const std::vector<cv::Mat>& disps,
+                     const std::vector<cv::Mat>& flows, const std::vector<int>& gaps,
+                     const core::Camera& c, const core::Envelope& e, const SceneFlowParams& p) {
+  NaiveOut out;
+  const double d = cur.at<float>(y, x);
+  if (!(d > 0)) return out;
+  const double z = c.focal_px * c.baseline_m / d;
+  const cv::Vec3d P((x - c.cx) * z / c.focal_px, (y - c.cy) * z / c.focal_px, z);
+  int best_valid_gap = 0;
+  for (int k : gaps) {
+    if (k > static_cast<int>(disps.size())) continue;
+    double qx = x, qy = y;
+    bool ok = true;
+    for (int m = 0; m < k && ok; ++m) {
+      double u, v;
+      ok = naive_sample(flows[m], 0, qx, qy, u) && naive_sample(flows[m], 1, qx, qy, v);
+      // Positions are float in the implementation; keep the reference on the same grid.
+      qx = static_cast<float>(static_cast<float>(qx) + static_cast<float>(u));
+      qy = static_cast<float>(static_cast<float>(qy) + static_cast<float>(v));
+    }
+    double dp;
+    if (!ok || !naive_sample(disps[k - 1], 0, qx, qy, dp, p.max_disparity_step_px) || !(dp > 0))
+      continue;
+    const double zp = c.focal_px * c.baseline_m / dp;
+    const cv::Vec3d Pp((qx - c.cx) * zp / c.focal_px, (qy - c.cy) * zp / c.focal_px, zp);
+    const cv::Vec3d V = (P - Pp) / (k * kDt);
+    bool flag = z <= p.z_max_m && d - dp >= p.min_delta_d_px && cv::norm(V) <= p.max_speed_mps &&
+                V[2] <= -p.v_min_mps;
+    double tc = 0;
+    if (flag) {
+      tc = (z - e.z_contact_m) / -V[2];
+      const double X = P[0] + V[0] * tc, Y = P[1] + V[1] * tc;
+      flag = tc > 0 && tc <= e.horizon_s && std::abs(X) <= e.half_width_m && Y >= e.y_top_m &&
+             Y <= e.y_bottom_m;
+    }
+    if (flag && (!out.danger || tc < out.ttc)) {
+      out.ttc = tc;
+      out.vel = V;
+    }
+    out.danger = out.danger || flag;
+    if (!out.danger && k > best_valid_gap) {
+      out.vel = V;
+      best_valid_gap = k;
+    }
+  }
+  return out;
+}
+
+/// Smooth random disparity in [lo, hi] with ~8% invalid pixels, as a ROI of a larger matrix so
+/// that rows are not contiguous.
+cv::Mat random_disparity(cv::Size size, double lo, double hi, cv::RNG& rng) {
+  cv::Mat big(size.height + 6, size.width + 9, CV_32F);
+  rng.fill(big, cv::RNG::UNIFORM, 0.0, 1.0);
+  cv::GaussianBlur(big, big, cv::Size(0, 0), 3.0);
+  cv::normalize(big, big, lo, hi, cv::NORM_MINMAX);
+  cv::Mat roi = big(cv::Rect(4, 3, size.width, size.height));
+  for (int i = 0; i < size.area() / 12; ++i)
+    roi.at<float>(rng.uniform(0, size.height), rng.uniform(0, size.width)) = -1.0f;
+  return roi;
+}
+
+cv::Mat random_flow(cv::Size size, double amplitude, cv::RNG& rng) {
+  cv::Mat big(size.height + 4, size.width + 5, CV_32FC2);
+  rng.fill(big, cv::RNG::UNIFORM, -amplitude, amplitude);
+  cv::GaussianBlur(big, big, cv::Size(0, 0), 2.0);
+  return big(cv::Rect(2, 1, size.width, size.height));
+}
+
+void compare_with_naive(const std::vector<int>& gaps, int history, uint64_t seed) {
+  core::Camera cam = odd_camera();
+  cam.width = 63;
+  cam.height = 49;
+  cam.cx = 31.2;
+  cam.cy = 24.6;
+  const cv::Size size(cam.width, cam.height);
+  core::Envelope env;
+  env.half_width_m = 1.5;
+  env.y_top_m = -1.5;
+  env.y_bottom_m = 1.5;
+  SceneFlowParams p;
+  p.gaps = gaps;
+  p.min_delta_d_px = 0.2;
+  p.max_disparity_step_px = 1.5;
+  cv::RNG rng(seed);
+  const cv::Mat cur = random_disparity(size, 8.0, 30.0, rng);
+  std::vector<cv::Mat> disps, flows;
+  std::vector<const cv::Mat*> dp, fp;
+  for (int j = 0; j < history; ++j) {
+    disps.push_back(random_disparity(size, 6.0, 28.0, rng));
+    flows.push_back(random_flow(size, 6.0, rng));
+  }
+  for (int j = 0; j < history; ++j) {
+    dp.push_back(&disps[j]);
+    fp.push_back(&flows[j]);
+  }
+  cv::Mat danger, ttc, vel;
+  if (gaps.size() == 1 && gaps[0] == 1 && history == 1)
+    label_stereo_flow(cur, disps[0], flows[0], cam, env, p, kDt, danger, ttc, vel);
+  else
+    label_stereo_flow_window(cur, dp, fp, cam, env, p, kDt, danger, ttc, vel);
+  int flagged = 0, known = 0;
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) {
+      const NaiveOut r = naive_pixel(x, y, cur, disps, flows, gaps, cam, env, p);
+      ASSERT_EQ(danger.at<uint8_t>(y, x), r.danger ? 255 : 0) << x << "," << y;
+      flagged += r.danger;
+      if (r.danger) {
+        EXPECT_NEAR(ttc.at<float>(y, x), r.ttc, 1e-4 * (1 + r.ttc)) << x << "," << y;
+      } else {
+        EXPECT_TRUE(std::isnan(ttc.at<float>(y, x))) << x << "," << y;
+      }
+      const cv::Vec3f v = vel.at<cv::Vec3f>(y, x);
+      if (std::isnan(r.vel[0])) {
+        EXPECT_TRUE(std::isnan(v[0])) << x << "," << y;
+        continue;
+      }
+      ++known;
+      for (int i = 0; i < 3; ++i)
+        EXPECT_NEAR(v[i], r.vel[i], 1e-3 * (1 + std::abs(r.vel[i]))) << x << "," << y;
+    }
+  // The random maps must exercise both outcomes.
+  EXPECT_GT(flagged, 30);
+  EXPECT_LT(flagged, size.area() * 4 / 5);
+  EXPECT_GT(known, size.area() / 3);
+}
+
+TEST(LabelStereoFlow, MatchesNaiveReferenceOnRandomMaps) {
+  for (uint64_t seed : {1u, 2u, 3u}) compare_with_naive({1}, 1, seed);
+}
+
+TEST(LabelStereoFlowWindow, MatchesNaiveReferenceOnRandomMaps) {
+  for (uint64_t seed : {4u, 5u}) compare_with_naive({3, 1, 2}, 3, seed);
+  compare_with_naive({1, 2, 5}, 3, 6);  // gap 5 lacks history and is skipped
+}
+
+// A fronto-parallel 0.6 m square on the optical axis approaching at 3 m/s from 9 m: it reaches
+// z_contact in 8.5 / 3 = 2.83 s, within the horizon, but its disparity grows by only 0.07 px per
+// frame, below min_delta_d_px = 0.5 (and below stereo noise). Over 10 frames it grows by 0.67 px.
+class FarApproach : public ::testing::Test {
+ protected:
+  static constexpr int kFrames = 11;  // D_i .. D_{i-10}
+  void SetUp() override {
+    cam_.width = 201;
+    cam_.height = 151;
+    cam_.focal_px = 500.0;
+    cam_.baseline_m = 0.12;  // f B = 60
+    cam_.cx = 100.0;
+    cam_.cy = 75.0;
+    for (int j = 0; j < kFrames; ++j) {
+      const double z = 9.0 + 3.0 * kDt * j;  // frame i - j
+      cv::Mat d(cam_.height, cam_.width, CV_32F, cv::Scalar(2.0f));  // wall at 30 m
+      cv::rectangle(d, square(z), cv::Scalar(60.0 / z), cv::FILLED);
+      disps_.push_back(d);
+    }
+    // Flow of frame i - j back to i - j - 1: the square shrinks about the principal point.
+    for (int j = 0; j + 1 < kFrames; ++j) {
+      const double scale = (9.0 + 3.0 * kDt * j) / (9.0 + 3.0 * kDt * (j + 1));
+      cv::Mat f(cam_.height, cam_.width, CV_32FC2, cv::Scalar(0, 0));
+      const cv::Rect r = square(9.0 + 3.0 * kDt * j);
+      for (int y = r.y; y < r.br().y; ++y)
+        for (int x = r.x; x < r.br().x; ++x)
+          f.at<cv::Vec2f>(y, x) = cv::Vec2f(static_cast<float>((x - cam_.cx) * (scale - 1)),
+                                            static_cast<float>((y - cam_.cy) * (scale - 1)));
+      flows_.push_back(f);
+    }
+  }
+  cv::Rect square(double z) const {
+    const int half = static_cast<int>(cam_.focal_px * 0.3 / z);
+    return {static_cast<int>(cam_.cx) - half, static_cast<int>(cam_.cy) - half, 2 * half + 1,
+            2 * half + 1};
+  }
+  void label(const std::vector<int>& gaps, int history) {
+    std::vector<const cv::Mat*> d, f;
+    for (int j = 0; j < history; ++j) {
+      d.push_back(&disps_[j + 1]);
+      f.push_back(&flows_[j]);
+    }
+    SceneFlowParams p;
+    p.gaps = gaps;
+    label_stereo_flow_window(disps_[0], d, f, cam_, {}, p, kDt, danger_, ttc_, vel_);
+  }
+  core::Camera cam_;
+  std::vector<cv::Mat> disps_, flows_;
+  cv::Mat danger_, ttc_, vel_;
+};
+
+TEST_F(FarApproach, InvisibleAtGapOne) {
+  label({1}, 10);
+  EXPECT_EQ(cv::countNonZero(danger_), 0);
+  // The velocity is there (gap 1 is noise-free here), only the disparity gate rejects it.
+  EXPECT_NEAR(vel_.at<cv::Vec3f>(75, 100)[2], -3.0, 0.05);
+  label({1, 4}, 10);
+  EXPECT_EQ(cv::countNonZero(danger_), 0);
+}
+
+TEST_F(FarApproach, CaughtAtGapTen) {
+  label({1, 4, 10}, 10);
+  const cv::Rect centre(90, 65, 21, 21);
+  EXPECT_EQ(cv::countNonZero(danger_(centre)), centre.area());
+  const double z_now = 60.0 / static_cast<float>(60.0 / 9.0);
+  const double z_then = 60.0 / static_cast<float>(60.0 / 10.0);
+  const double vz = (z_now - z_then) / (10 * kDt);
+  EXPECT_NEAR(ttc_.at<float>(75, 100), (z_now - 0.5) / -vz, 1e-3);
+  EXPECT_NEAR(vel_.at<cv::Vec3f>(75, 100)[2], -3.0, 1e-3);
+  // Nothing outside the square.
+  cv::Mat outside = danger_.clone();
+  outside(square(9.0)).setTo(0);
+  EXPECT_EQ(cv::countNonZero(outside), 0);
+}
+
+TEST_F(FarApproach, GapTenNeedsTenFrames) {
+  label({10}, 9);
+  EXPECT_EQ(cv::countNonZero(danger_), 0);
+  EXPECT_TRUE(std::isnan(vel_.at<cv::Vec3f>(75, 100)[0]));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Ground plane
+
+TEST(GroundPlane, FitsATiltedGroundAndSparesAnObstacle) {
+  core::Camera cam = odd_camera();
+  const double h = 1.0, pitch = 10.0 * CV_PI / 180.0;
+  const cv::Vec3d up(0.0, -std::cos(pitch), -std::sin(pitch));  // world up in camera coords
+  const double fb = cam.focal_px * cam.baseline_m;
+  cv::Mat disp(cam.height, cam.width, CV_32F, cv::Scalar(-1.0f));
+  cv::Mat truth_ground(disp.size(), CV_8U, cv::Scalar(0)), box(disp.size(), CV_8U, cv::Scalar(0));
+  cv::RNG rng(17);
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) {
+      const cv::Vec3d ray((x - cam.cx) / cam.focal_px, (y - cam.cy) / cam.focal_px, 1.0);
+      // Box: the plane Z = 3 m, 0.6 m wide, standing on the ground up to 0.8 m.
+      const cv::Vec3d on_box = ray * 3.0;
+      const double box_height = up.dot(on_box) + h;
+      if (std::abs(on_box[0]) <= 0.3 && box_height >= 0.0 && box_height <= 0.8) {
+        disp.at<float>(y, x) = static_cast<float>(fb / 3.0);
+        if (box_height > 0.1) box.at<uint8_t>(y, x) = 255;
+        continue;
+      }
+      const double denom = -up.dot(ray);  // ray reaches the ground at t = h / denom
+      if (denom <= 1e-3) continue;
+      const double z = h / denom;
+      if (z > 15.0) continue;
+      disp.at<float>(y, x) = static_cast<float>(fb / z + rng.uniform(-0.02, 0.02));
+      if (z < 8.0) truth_ground.at<uint8_t>(y, x) = 255;
+    }
+  const GroundPlane g = fit_ground_plane(disp, cam, GroundParams{});
+  ASSERT_TRUE(g.found);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(g.normal[i], up[i], 0.02) << i;
+  EXPECT_NEAR(g.offset, h, 0.03);
+  cv::Mat mask;
+  mark_ground(disp, cam, g, 0.05, mask);
+  ASSERT_EQ(mask.type(), CV_8UC1);
+  const int ground_px = cv::countNonZero(truth_ground);
+  cv::Mat hit;
+  cv::bitwise_and(mask, truth_ground, hit);
+  EXPECT_GT(cv::countNonZero(hit), 0.97 * ground_px);
+  cv::bitwise_and(mask, box, hit);
+  ASSERT_GT(cv::countNonZero(box), 100);
+  EXPECT_EQ(cv::countNonZero(hit), 0);
+  // A reproducible fit: same seed, same plane.
+  const GroundPlane again = fit_ground_plane(disp, cam, GroundParams{});
+  EXPECT_EQ(again.normal, g.normal);
+  EXPECT_EQ(again.offset, g.offset);
+}
+
+TEST(GroundPlane, NoPlaneWithoutPoints) {
+  const core::Camera cam = odd_camera();
+  const cv::Mat disp(cam.height, cam.width, CV_32F, cv::Scalar(-1.0f));
+  EXPECT_FALSE(fit_ground_plane(disp, cam, GroundParams{}).found);
+  cv::Mat mask;
+  mark_ground(disp, cam, GroundPlane{}, 0.05, mask);
+  EXPECT_EQ(cv::countNonZero(mask), 0);
+}
+
+}  // namespace
+}  // namespace sg::vision
