@@ -7,5 +7,7 @@ namespace sg::apps {
 void add_run_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
+void add_scenarios_command(CLI::App& app);
 
 }  // namespace sg::apps

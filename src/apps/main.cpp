@@ -11,6 +11,8 @@ int main(int argc, char** argv) {
   sg::apps::add_run_command(app);
   sg::apps::add_simulate_command(app);
   sg::apps::add_eval_command(app);
+  sg::apps::add_bench_command(app);
+  sg::apps::add_scenarios_command(app);
   try {
     if (argc == 1) {
       // No arguments: the main job on its built-in scenario.

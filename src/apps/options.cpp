@@ -38,10 +38,20 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                  "stereo search range, px (positive multiple of 16; default 64)");
   app.add_option("--block-size", o.block_size, "stereo block size, px (odd, 5..255)");
   app.add_option("--gaps", o.gaps,
-                 "frame gaps k compared in Stereo mode, e.g. --gaps 1 (the thesis) or 1,4,10")
+                 "frame gaps k compared by the mode's labelling, e.g. --gaps 1 (the thesis) or "
+                 "1,4,10 (Stereo mode default 1,5,15; Stereo-Flow 1,4,10,20)")
       ->delimiter(',');
+  app.add_option("--flow-method", o.flow_method,
+                 "Stereo-Flow optical flow: dis-ultrafast (default), dis-fast, dis-medium or "
+                 "farneback");
   app.add_option("--min-area", o.min_area, "smallest obstacle blob, px (default 150)");
   app.add_option("--fps", o.fps, "pace the input like a camera at this rate, Hz (0 = no pacing)");
+  app.add_option("--workers", o.workers, "W: farm workers computing SM/OF tasks at once (default 1)");
+  app.add_option("--tiles", o.tiles, "T: row tiles per task (default 1)");
+  app.add_option("--tokens", o.tokens, "frames in flight (default 0 = W + 1)");
+  app.add_option("--threads", o.threads, "threads of the task arena (default 0 = all cores)");
+  app.add_flag("--tile-flow", o.tile_flow,
+               "split optical flow into the T tiles too (faster, not bit-identical)");
 }
 
 pipeline::RunOptions make_run_options(const DetectorOptions& o) {
@@ -49,12 +59,27 @@ pipeline::RunOptions make_run_options(const DetectorOptions& o) {
   io::RunSettings settings;
   if (!o.config.empty()) io::apply_config_file(o.config, run.params, settings);
   run.pace_fps = settings.pace_fps;
+  run.workers = settings.workers;
+  run.tiles = settings.tiles;
+  run.tokens = settings.tokens;
+  run.threads = settings.threads;
   if (o.mode) run.params.mode = core::parse_mode(*o.mode);
   if (o.num_disparities) run.params.bm.num_disparities = *o.num_disparities;
   if (o.block_size) run.params.bm.block_size = *o.block_size;
-  if (o.gaps) run.params.stereo.gaps = *o.gaps;
+  if (o.gaps) {
+    if (run.params.mode == core::Mode::kStereoFlow)
+      run.params.scene_flow.gaps = *o.gaps;
+    else
+      run.params.stereo.gaps = *o.gaps;
+  }
+  if (o.flow_method) run.params.flow.method = core::parse_flow_method(*o.flow_method);
   if (o.min_area) run.params.signal.min_area_px = *o.min_area;
   if (o.fps) run.pace_fps = *o.fps;
+  if (o.workers) run.workers = *o.workers;
+  if (o.tiles) run.tiles = *o.tiles;
+  if (o.tokens) run.tokens = *o.tokens;
+  if (o.threads) run.threads = *o.threads;
+  if (o.tile_flow) run.tile_flow = true;
   return run;
 }
 

@@ -38,7 +38,10 @@ struct DetectorOptions {
   std::optional<std::string> mode;
   std::optional<int> num_disparities, block_size, min_area;
   std::optional<std::vector<int>> gaps;
+  std::optional<std::string> flow_method;
   std::optional<double> fps;
+  std::optional<int> workers, tiles, tokens, threads;
+  bool tile_flow = false;
 };
 
 void add_detector_options(CLI::App& app, DetectorOptions& options);

@@ -1,5 +1,6 @@
 // `stereoguard run`: the main job. Detects obstacles on a scenario or a stereo folder, writes
 // events, an overlay video and a summary.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -27,12 +28,13 @@ struct RunArgs {
 class WarningPrinter {
  public:
   void operator()(const core::Detection& d) {
-    // Severity may flicker with the TTC estimate: say only when it rises.
+    // Severity flickers with the TTC estimate: say only when it rises above what this warning
+    // already said.
     const bool changed = d.signal != last_signal_ || d.steering != last_steering_ ||
                          (d.signal && d.severity > last_severity_);
     last_signal_ = d.signal;
-    last_severity_ = d.severity;
     last_steering_ = d.steering;
+    last_severity_ = d.signal ? std::max(last_severity_, d.severity) : core::Severity::kNone;
     if (!changed) return;
     std::cout << "frame " << std::setw(4) << d.frame << "  t=" << std::fixed
               << std::setprecision(2) << d.time_s << " s  ";

@@ -37,6 +37,17 @@ void simulate_main(const SimulateArgs& args) {
 
 }  // namespace
 
+void add_scenarios_command(CLI::App& app) {
+  CLI::App* cmd = app.add_subcommand("scenarios", "list the built-in scenarios");
+  cmd->callback([] {
+    for (const std::string& name : sim::builtin_scenario_names()) {
+      const sim::Scenario s = sim::builtin_scenario(name);
+      std::cout << name << std::string(name.size() < 15 ? 15 - name.size() : 1, ' ')
+                << s.frames << " frames  " << s.description << "\n";
+    }
+  });
+}
+
 void add_simulate_command(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
   CLI::App* cmd = app.add_subcommand(

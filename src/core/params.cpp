@@ -96,6 +96,79 @@ std::vector<std::string> validate(const SignalParams& p) {
   return out;
 }
 
+const char* to_string(FlowMethod m) {
+  switch (m) {
+    case FlowMethod::kDisUltrafast:
+      return "dis-ultrafast";
+    case FlowMethod::kDisFast:
+      return "dis-fast";
+    case FlowMethod::kDisMedium:
+      return "dis-medium";
+    case FlowMethod::kFarneback:
+      return "farneback";
+  }
+  return "?";
+}
+
+FlowMethod parse_flow_method(const std::string& text) {
+  for (FlowMethod m : {FlowMethod::kDisUltrafast, FlowMethod::kDisFast, FlowMethod::kDisMedium,
+                       FlowMethod::kFarneback})
+    if (text == to_string(m)) return m;
+  throw InputError("flow.method=" + text +
+                   ": must be dis-ultrafast, dis-fast, dis-medium or farneback");
+}
+
+std::vector<std::string> validate(const FlowParams& p) {
+  std::vector<std::string> out;
+  Checker c(out, "flow");
+  c.require(p.tile_halo_px >= 0, "tile_halo_px", p.tile_halo_px, "must be >= 0");
+  if (p.method != FlowMethod::kFarneback) return out;
+  c.require(std::isfinite(p.fb_pyr_scale) && p.fb_pyr_scale > 0 && p.fb_pyr_scale < 1,
+            "fb_pyr_scale", p.fb_pyr_scale, "must be in (0, 1)");
+  c.require(p.fb_levels >= 1, "fb_levels", p.fb_levels, "must be >= 1");
+  c.require(p.fb_win_size >= 3, "fb_win_size", p.fb_win_size, "must be >= 3");
+  c.require(p.fb_iterations >= 1, "fb_iterations", p.fb_iterations, "must be >= 1");
+  c.require(p.fb_poly_n == 5 || p.fb_poly_n == 7, "fb_poly_n", p.fb_poly_n, "must be 5 or 7");
+  c.require(finite_positive(p.fb_poly_sigma), "fb_poly_sigma", p.fb_poly_sigma, "must be > 0");
+  return out;
+}
+
+std::vector<std::string> validate(const GroundParams& p) {
+  std::vector<std::string> out;
+  Checker c(out, "ground");
+  c.require(std::isfinite(p.lower_fraction) && p.lower_fraction > 0 && p.lower_fraction <= 1,
+            "lower_fraction", p.lower_fraction, "must be in (0, 1]");
+  c.require(p.sample_step_px >= 1, "sample_step_px", p.sample_step_px, "must be >= 1");
+  c.require(p.iterations >= 1, "iterations", p.iterations, "must be >= 1");
+  c.require(finite_positive(p.tolerance_m), "tolerance_m", p.tolerance_m, "must be > 0");
+  c.require(finite_positive(p.z_max_m), "z_max_m", p.z_max_m, "must be > 0");
+  c.require(p.min_inliers >= 3, "min_inliers", p.min_inliers, "must be >= 3");
+  return out;
+}
+
+std::vector<std::string> validate(const SceneFlowParams& p) {
+  std::vector<std::string> out;
+  Checker c(out, "scene_flow");
+  c.require(!p.gaps.empty(), "gaps", "[]", "must list at least one frame gap");
+  for (int k : p.gaps) c.require(k >= 1 && k <= 60, "gaps", k, "each gap must be in 1..60");
+  c.require(finite_positive(p.v_min_mps), "v_min_mps", p.v_min_mps, "must be > 0");
+  c.require(finite_positive(p.z_max_m), "z_max_m", p.z_max_m, "must be > 0");
+  c.require(std::isfinite(p.min_delta_d_px) && p.min_delta_d_px >= 0, "min_delta_d_px",
+            p.min_delta_d_px, "must be >= 0");
+  c.require(p.max_speed_mps > p.v_min_mps, "max_speed_mps", p.max_speed_mps,
+            "must exceed v_min_mps");
+  c.require(p.max_disparity_step_px > 0, "max_disparity_step_px", p.max_disparity_step_px,
+            "must be > 0 (infinity disables)");
+  c.require(p.edge_margin_px >= 0 && p.edge_margin_px <= 50, "edge_margin_px", p.edge_margin_px,
+            "must be in 0..50 (0 disables)");
+  c.require(finite_positive(p.edge_step_px), "edge_step_px", p.edge_step_px, "must be > 0");
+  if (p.exclude_ground) {
+    std::vector<std::string> more = validate(p.ground);
+    out.insert(out.end(), more.begin(), more.end());
+  }
+  return out;
+}
+
 std::vector<std::string> validate(const DetectorParams& p, const Camera& camera) {
   std::vector<std::string> out = validate(camera);
   auto append = [&out](std::vector<std::string> more) {
@@ -105,6 +178,8 @@ std::vector<std::string> validate(const DetectorParams& p, const Camera& camera)
   append(validate(p.envelope));
   append(validate(p.stereo));
   append(validate(p.signal));
+  append(validate(p.flow));
+  append(validate(p.scene_flow));
   Checker c(out, "stereo");
   c.require(p.bm.min_disparity + p.bm.num_disparities < camera.width, "num_disparities",
             p.bm.num_disparities, "min_disparity + num_disparities must be below the image width");

@@ -72,10 +72,16 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
     Section(root, "config")
         .field("mode", mode)
         .field("fps", settings.pace_fps)
+        .field("workers", settings.workers)
+        .field("tiles", settings.tiles)
+        .field("tokens", settings.tokens)
+        .field("threads", settings.threads)
         .section("stereo")
         .section("label")
         .section("envelope")
         .section("signal")
+        .section("flow")
+        .section("scene_flow")
         .done();
     p.mode = core::parse_mode(mode);
     Section(root["stereo"], "stereo")
@@ -113,6 +119,43 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("ttc_danger_s", p.signal.ttc_danger_s)
         .field("ttc_warning_s", p.signal.ttc_warning_s)
         .done();
+    std::string method = core::to_string(p.flow.method);
+    Section(root["flow"], "flow")
+        .field("method", method)
+        .field("tile_halo_px", p.flow.tile_halo_px)
+        .field("fb_pyr_scale", p.flow.fb_pyr_scale)
+        .field("fb_levels", p.flow.fb_levels)
+        .field("fb_win_size", p.flow.fb_win_size)
+        .field("fb_iterations", p.flow.fb_iterations)
+        .field("fb_poly_n", p.flow.fb_poly_n)
+        .field("fb_poly_sigma", p.flow.fb_poly_sigma)
+        .done();
+    p.flow.method = core::parse_flow_method(method);
+    YAML::Node scene_flow = root["scene_flow"];
+    Section(scene_flow, "scene_flow")
+        .field("gaps", p.scene_flow.gaps)
+        .field("v_min_mps", p.scene_flow.v_min_mps)
+        .field("z_max_m", p.scene_flow.z_max_m)
+        .field("min_delta_d_px", p.scene_flow.min_delta_d_px)
+        .field("max_speed_mps", p.scene_flow.max_speed_mps)
+        .field("max_disparity_step_px", p.scene_flow.max_disparity_step_px)
+        .field("edge_margin_px", p.scene_flow.edge_margin_px)
+        .field("edge_step_px", p.scene_flow.edge_step_px)
+        .field("longest_gap_decides", p.scene_flow.longest_gap_decides)
+        .field("use_envelope_band", p.scene_flow.use_envelope_band)
+        .field("exclude_ground", p.scene_flow.exclude_ground)
+        .section("ground")
+        .done();
+    if (scene_flow && scene_flow.IsMap()) {
+      Section(scene_flow["ground"], "scene_flow.ground")
+          .field("lower_fraction", p.scene_flow.ground.lower_fraction)
+          .field("sample_step_px", p.scene_flow.ground.sample_step_px)
+          .field("iterations", p.scene_flow.ground.iterations)
+          .field("tolerance_m", p.scene_flow.ground.tolerance_m)
+          .field("z_max_m", p.scene_flow.ground.z_max_m)
+          .field("min_inliers", p.scene_flow.ground.min_inliers)
+          .done();
+    }
   } catch (const core::InputError& e) {
     throw core::InputError("config file " + file + ": " + e.what());
   }

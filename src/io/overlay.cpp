@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <vector>
 
 #include "sg/core/error.hpp"
 
@@ -53,25 +54,42 @@ void tint_danger(cv::Mat& out, const cv::Mat& danger) {
   tinted.copyTo(out, mask);
 }
 
+/// Per obstacle: its box and a label of one or two lines, "Z m  TTC t s" and, when the
+/// obstacle has a 3D velocity (Stereo-Flow), "v X,Y,Z m/s".
 void draw_obstacles(cv::Mat& out, const std::vector<core::Obstacle>& obstacles, double scale,
                     int bar_height) {
   for (const auto& o : obstacles) {
     cv::rectangle(out, o.bbox, kRed, 2);
-    char label[64];
+    std::vector<std::string> lines;
+    char text[96];
     if (o.ttc_s) {
-      std::snprintf(label, sizeof label, "%.1f m  TTC %.1f s", o.distance_m, *o.ttc_s);
+      std::snprintf(text, sizeof text, "%.1f m  TTC %.1f s", o.distance_m, *o.ttc_s);
     } else {
-      std::snprintf(label, sizeof label, "%.1f m", o.distance_m);
+      std::snprintf(text, sizeof text, "%.1f m", o.distance_m);
     }
-    int baseline = 0;
-    const cv::Size ts = cv::getTextSize(label, kFont, scale, 1, &baseline);
-    // Above the box when there is room below the bar, else just inside its top edge.
-    int y = o.bbox.y - 3;
-    if (y - ts.height < bar_height) y = o.bbox.y + ts.height + 3;
-    const cv::Point origin(std::max(0, o.bbox.x), y);
-    cv::rectangle(out, cv::Rect(origin.x, y - ts.height - 2, ts.width + 2, ts.height + baseline + 2),
-                  kBlack, cv::FILLED);
-    put_text(out, label, origin + cv::Point(1, 0), scale, kRed);
+    lines.emplace_back(text);
+    if (o.velocity) {
+      const cv::Vec3d& v = *o.velocity;
+      std::snprintf(text, sizeof text, "v %.1f,%.1f,%.1f m/s", v[0], v[1], v[2]);
+      lines.emplace_back(text);
+    }
+    int baseline = 0, width = 0, height = 0;
+    for (const auto& line : lines) {
+      const cv::Size ts = cv::getTextSize(line, kFont, scale, 1, &baseline);
+      width = std::max(width, ts.width);
+      height = std::max(height, ts.height);
+    }
+    const int step = height + baseline + 2;
+    const int extra = step * (static_cast<int>(lines.size()) - 1);
+    // Above the box when there is room below the bar, else just inside its top edge. y: the
+    // first line's baseline.
+    int y = o.bbox.y - 3 - extra;
+    if (y - height < bar_height) y = o.bbox.y + height + 3;
+    const int x = std::max(0, o.bbox.x);
+    cv::rectangle(out, cv::Rect(x, y - height - 2, width + 2, step + extra), kBlack, cv::FILLED);
+    for (size_t i = 0; i < lines.size(); ++i)
+      put_text(out, lines[i], cv::Point(x + 1, y + static_cast<int>(i) * step),
+               scale, kRed);
   }
 }
 

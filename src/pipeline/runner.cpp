@@ -1,39 +1,149 @@
 #include "sg/pipeline/runner.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
 #include <thread>
 
 #include "sg/core/error.hpp"
+#include "sg/par/backend.hpp"
+#include "sg/par/farm.hpp"
+#include "sg/par/metrics.hpp"
+#include "sg/par/tiles.hpp"
 #include "sg/vision/detector.hpp"
+#include "sg/vision/frame_kernels.hpp"
 
 namespace sg::pipeline {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+/// One frame travelling through the farm.
+struct FrameJob {
+  core::StereoFrame frame;
+  cv::Mat previous_left;  ///< L_{i-1} for the flow task; empty for the first frame
+  vision::FrameMaps maps;
+  par::TimePoint acquired;
+  double sm_ms = 0.0, of_ms = 0.0;
+};
 
-double ms_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::milli>(b - a).count();
+/// The emitter: reads frames, paces them like a camera and drops what a camera would overwrite.
+/// A paced frame is "acquired" at its capture time, so its latency includes any wait for a token.
+class Emitter {
+ public:
+  Emitter(core::FrameSource& source, double pace_fps) : source_(source), pace_fps_(pace_fps) {}
+
+  std::optional<FrameJob> operator()() {
+    const par::TimePoint begin = par::now();
+    std::optional<core::StereoFrame> frame = source_.next();
+    if (!frame) return std::nullopt;
+    if (pace_fps_ > 0) {
+      // A camera overwrites a frame nobody took before the next one arrived: while the successor
+      // of this frame has been captured already, this frame is lost (dropped) and the successor
+      // takes its place. The last frame of a stream has no successor and is never dropped.
+      while (capture_time(emitted_ + dropped_ + 1) <= par::now()) {
+        std::optional<core::StereoFrame> successor = source_.next();
+        if (!successor) break;
+        ++dropped_;
+        frame = std::move(successor);
+      }
+    }
+    vision::check_frame(*frame);
+    FrameJob job;
+    job.previous_left = previous_left_;
+    previous_left_ = frame->left;
+    job.frame = std::move(*frame);
+    busy_ms_ += par::elapsed_ms(begin);
+    if (pace_fps_ > 0) {
+      job.acquired = capture_time(emitted_ + dropped_);
+      std::this_thread::sleep_until(job.acquired);
+    } else {
+      job.acquired = par::now();
+    }
+    ++emitted_;
+    return job;
+  }
+
+  int dropped() const { return dropped_; }
+  double busy_ms() const { return busy_ms_; }
+  void start(par::TimePoint t0) { t0_ = t0; }
+
+ private:
+  /// When the paced camera captures its n-th frame.
+  par::TimePoint capture_time(int n) const {
+    return t0_ + std::chrono::duration_cast<par::Clock::duration>(
+                     std::chrono::duration<double>(n / pace_fps_));
+  }
+
+  core::FrameSource& source_;
+  double pace_fps_;
+  par::TimePoint t0_;
+  cv::Mat previous_left_;
+  int emitted_ = 0, dropped_ = 0;
+  double busy_ms_ = 0.0;
+};
+
+/// Runs `kernel(rows)` over T row tiles of `rows_total` rows.
+template <class Kernel>
+void tiled(int rows_total, int tiles, Kernel&& kernel) {
+  if (tiles <= 1) {
+    kernel(cv::Range::all());
+    return;
+  }
+  par::parallel_for_tiles(rows_total, tiles,
+                          [&](int, int begin, int end) { kernel(cv::Range(begin, end)); });
 }
 
-/// Nearest-rank percentile of sorted samples.
-double percentile(const std::vector<double>& sorted, double q) {
-  if (sorted.empty()) return 0.0;
-  const auto rank = static_cast<size_t>(std::ceil(q * static_cast<double>(sorted.size())));
-  return sorted[std::clamp<size_t>(rank, 1, sorted.size()) - 1];
+/// The farm's tasks for one frame: SM always, OF in Stereo-Flow mode from the second frame on.
+par::TaskList make_tasks(FrameJob& job, const RunOptions& o) {
+  const bool with_flow = o.params.mode == core::Mode::kStereoFlow && !job.previous_left.empty();
+  vision::allocate_maps(job.frame.left.size(), with_flow, job.maps.disparity, job.maps.flow);
+  par::TaskList tasks;
+  tasks.emplace_back([&job, &o] {
+    const par::Stopwatch watch;
+    tiled(job.frame.left.rows, o.tiles, [&](cv::Range rows) {
+      vision::disparity_rows(job.frame, o.params, job.maps.disparity, rows);
+    });
+    vision::disparity_finish(o.params, job.maps.disparity);
+    job.sm_ms = watch.elapsed_ms();
+  });
+  if (with_flow) {
+    tasks.emplace_back([&job, &o] {
+      const par::Stopwatch watch;
+      tiled(job.frame.left.rows, o.tile_flow ? o.tiles : 1, [&](cv::Range rows) {
+        vision::flow_rows(job.frame.left, job.previous_left, o.params, job.maps.flow, rows);
+      });
+      job.of_ms = watch.elapsed_ms();
+    });
+  }
+  return tasks;
+}
+
+std::string format_ms(double v) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(1) << v;
+  return s.str();
 }
 
 }  // namespace
 
-std::vector<std::string> validate(const RunOptions& options, const core::Camera& camera) {
-  std::vector<std::string> out = core::validate(options.params, camera);
-  if (!std::isfinite(options.pace_fps) || options.pace_fps < 0) {
-    std::ostringstream s;
-    s << "fps=" << options.pace_fps << ": must be >= 0 (0 = as fast as possible)";
-    out.push_back(s.str());
-  }
+int effective_tokens(const RunOptions& o) { return o.tokens > 0 ? o.tokens : o.workers + 1; }
+
+std::vector<std::string> validate(const RunOptions& o, const core::Camera& camera) {
+  std::vector<std::string> out = core::validate(o.params, camera);
+  auto require = [&out](bool ok, const std::string& what) {
+    if (!ok) out.push_back(what);
+  };
+  require(std::isfinite(o.pace_fps) && o.pace_fps >= 0,
+          "fps=" + format_ms(o.pace_fps) + ": must be >= 0 (0 = as fast as possible)");
+  require(o.workers >= 1 && o.workers <= 64,
+          "workers=" + std::to_string(o.workers) + ": must be in 1..64");
+  require(o.tiles >= 1 && o.tiles <= 64, "tiles=" + std::to_string(o.tiles) + ": must be in 1..64");
+  require(o.tiles <= camera.height / 8 || o.tiles == 1,
+          "tiles=" + std::to_string(o.tiles) + ": at most image height / 8 (" +
+              std::to_string(camera.height / 8) + ")");
+  require(o.tokens >= 0 && o.tokens <= 256,
+          "tokens=" + std::to_string(o.tokens) + ": must be in 0..256 (0 = automatic)");
+  require(o.threads >= 0 && o.threads <= 256,
+          "threads=" + std::to_string(o.threads) + ": must be in 0..256 (0 = all cores)");
   return out;
 }
 
@@ -41,56 +151,85 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   core::throw_if_invalid(validate(options, source.camera()), "invalid parameters");
   vision::Detector detector(options.params, source.camera());
 
-  RunSummary summary;
-  std::vector<double> latencies;
-  const Clock::time_point start = Clock::now();
-  Clock::time_point last_done = start;
-  double service_sum_ms = 0.0;
-  while (true) {
-    if (options.pace_fps > 0) {
-      const auto due = start + std::chrono::duration_cast<Clock::duration>(
-                                   std::chrono::duration<double>(summary.frames / options.pace_fps));
-      std::this_thread::sleep_until(due);
-    }
-    std::optional<core::StereoFrame> frame = source.next();
-    if (!frame) break;
-    const Clock::time_point acquired = Clock::now();
-    vision::FrameMaps maps;
-    vision::compute_disparity(*frame, options.params, maps.disparity);
-    core::Detection detection = detector.process(*frame, maps);
-    const Clock::time_point done = Clock::now();
-    detection.latency_ms = ms_between(acquired, done);
-    latencies.push_back(detection.latency_ms);
-    if (summary.frames > 0) service_sum_ms += ms_between(last_done, done);
-    last_done = done;
+  RunSummary s;
+  s.mode = core::to_string(options.params.mode);
+  s.workers = options.workers;
+  s.tiles = options.tiles;
+  s.tokens = effective_tokens(options);
+  s.threads = options.threads;
+  s.tile_flow = options.tile_flow;
+  s.pace_fps = options.pace_fps;
 
-    ++summary.frames;
+  par::FarmConfig farm;
+  farm.backend = options.workers == 1 && options.tiles == 1 ? par::Backend::kSequential
+                                                             : par::Backend::kTbb;
+  farm.workers = options.workers;
+  farm.tokens = s.tokens;
+  farm.threads = options.threads;
+
+  Emitter emitter(source, options.pace_fps);
+  par::LatencyStats latency;
+  const par::TimePoint start = par::now();
+  emitter.start(start);
+  par::TimePoint last_done = start;
+  double service_sum_ms = 0.0;
+  const double deadline_ms = options.pace_fps > 0 ? 1000.0 / options.pace_fps : 0.0;
+
+  auto collect = [&](FrameJob&& job) {
+    const par::Stopwatch watch;
+    core::Detection detection = detector.process(job.frame, job.maps);
+    const par::TimePoint done = par::now();
+    detection.latency_ms = par::elapsed_ms(job.acquired, done);
+    latency.add(detection.latency_ms);
+    if (s.frames > 0) service_sum_ms += par::elapsed_ms(last_done, done);
+    last_done = done;
+    ++s.frames;
+    if (deadline_ms > 0 && detection.latency_ms > deadline_ms) ++s.deadline_misses;
     if (detection.signal) {
-      ++summary.alarm_frames;
-      if (!summary.first_alarm_frame) {
-        summary.first_alarm_frame = detection.frame;
-        summary.first_alarm_time_s = detection.time_s;
+      ++s.alarm_frames;
+      if (!s.first_alarm_frame) {
+        s.first_alarm_frame = detection.frame;
+        s.first_alarm_time_s = detection.time_s;
       }
     }
-    sink(*frame, detection);
+    s.busy_sm_ms += job.sm_ms;
+    s.busy_of_ms += job.of_ms;
+    sink(job.frame, detection);
+    s.busy_collector_ms += watch.elapsed_ms();
+  };
+
+  try {
+    par::run_in_arena(options.threads, [&] {
+      par::run_ordered_farm_tasks(
+          farm, [&] { return emitter(); },
+          [&](FrameJob& job) { return make_tasks(job, options); }, collect);
+    });
+  } catch (const cv::Exception& e) {
+    // OpenCV rejects what our validation let through only for broken input.
+    throw core::InputError(std::string("processing failed: ") + e.what());
   }
-  summary.wall_s = std::chrono::duration<double>(last_done - start).count();
-  summary.throughput_fps = summary.wall_s > 0 ? summary.frames / summary.wall_s : 0.0;
-  summary.service_ms = summary.frames > 1 ? service_sum_ms / (summary.frames - 1) : 0.0;
-  std::sort(latencies.begin(), latencies.end());
-  summary.latency_p50_ms = percentile(latencies, 0.50);
-  summary.latency_p95_ms = percentile(latencies, 0.95);
-  summary.latency_p99_ms = percentile(latencies, 0.99);
-  summary.latency_max_ms = latencies.empty() ? 0.0 : latencies.back();
-  return summary;
+
+  s.dropped = emitter.dropped();
+  s.busy_emitter_ms = emitter.busy_ms();
+  s.wall_s = std::chrono::duration<double>(last_done - start).count();
+  s.throughput_fps = s.wall_s > 0 ? s.frames / s.wall_s : 0.0;
+  s.service_ms = s.frames > 1 ? service_sum_ms / (s.frames - 1) : 0.0;
+  s.latency_p50_ms = latency.p50();
+  s.latency_p95_ms = latency.p95();
+  s.latency_p99_ms = latency.p99();
+  s.latency_max_ms = latency.max();
+  s.latency_mean_ms = latency.mean();
+  return s;
 }
 
 nlohmann::json RunSummary::to_json() const {
   auto opt = [](const auto& v) { return v ? nlohmann::json(*v) : nlohmann::json(); };
   return {{"frames", frames},
+          {"dropped", dropped},
           {"alarm_frames", alarm_frames},
           {"first_alarm_frame", opt(first_alarm_frame)},
           {"first_alarm_time_s", opt(first_alarm_time_s)},
+          {"deadline_misses", deadline_misses},
           {"wall_s", wall_s},
           {"throughput_fps", throughput_fps},
           {"service_ms", service_ms},
@@ -98,22 +237,40 @@ nlohmann::json RunSummary::to_json() const {
            {{"p50", latency_p50_ms},
             {"p95", latency_p95_ms},
             {"p99", latency_p99_ms},
-            {"max", latency_max_ms}}}};
+            {"max", latency_max_ms},
+            {"mean", latency_mean_ms}}},
+          {"busy_ms",
+           {{"emitter", busy_emitter_ms},
+            {"stereo_matching", busy_sm_ms},
+            {"optical_flow", busy_of_ms},
+            {"collector", busy_collector_ms}}},
+          {"config",
+           {{"mode", mode},
+            {"workers", workers},
+            {"tiles", tiles},
+            {"tokens", tokens},
+            {"threads", threads},
+            {"tile_flow", tile_flow},
+            {"fps", pace_fps}}}};
 }
 
 std::string RunSummary::text() const {
   std::ostringstream s;
   s << std::fixed << std::setprecision(1);
-  s << "frames processed  " << frames << "\n";
+  s << "frames processed  " << frames;
+  if (pace_fps > 0) s << " (dropped " << dropped << ", deadline misses " << deadline_misses << ")";
+  s << "\n";
   s << "alarm frames      " << alarm_frames << "\n";
   s << "first alarm       ";
   if (first_alarm_frame) {
     s << "frame " << *first_alarm_frame << " (t = " << std::setprecision(2)
-      << *first_alarm_time_s << " s)\n" << std::setprecision(1);
+      << *first_alarm_time_s << " s)\n"
+      << std::setprecision(1);
   } else {
     s << "none\n";
   }
-  s << "throughput        " << throughput_fps << " fps (" << wall_s << " s wall)\n";
+  s << "throughput        " << throughput_fps << " fps (" << wall_s << " s wall; mode " << mode
+    << ", W " << workers << ", T " << tiles << ", tokens " << tokens << ")\n";
   s << "latency ms        p50 " << latency_p50_ms << "  p95 " << latency_p95_ms << "  p99 "
     << latency_p99_ms << "  max " << latency_max_ms << "\n";
   return s.str();

@@ -1,17 +1,45 @@
 #include "sg/vision/detector.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "sg/core/error.hpp"
 #include "sg/vision/labelling.hpp"
+#include "sg/vision/scene_flow.hpp"
 #include "sg/vision/stereo_bm.hpp"
 
 namespace sg::vision {
 
 Detector::Detector(const core::DetectorParams& params, const core::Camera& camera)
     : params_(params), camera_(camera), hysteresis_(params.signal) {
-  if (params_.mode == core::Mode::kStereoFlow)
-    throw core::InputError("stereo-flow mode is not implemented yet");
+  const std::vector<int>& gaps =
+      params_.mode == core::Mode::kStereoFlow ? params_.scene_flow.gaps : params_.stereo.gaps;
+  if (!gaps.empty()) max_gap_ = std::max(1, *std::max_element(gaps.begin(), gaps.end()));
+}
+
+void Detector::label_flow(const FrameMaps& maps, cv::Mat& danger, cv::Mat& ttc,
+                          cv::Mat& velocity) {
+  const cv::Mat& disp = maps.disparity;
+  // Gap k needs D_{i-k} and B_i ... B_{i-k+1}: the current flow plus k - 1 stored ones.
+  std::vector<const cv::Mat*> flows;
+  if (!maps.flow.empty()) {
+    flows.push_back(&maps.flow);
+    for (const cv::Mat& f : flows_) flows.push_back(&f);
+  }
+  std::vector<const cv::Mat*> disps, edges;
+  for (const cv::Mat& d : past_) disps.push_back(&d);
+  for (const cv::Mat& e : past_edges_) edges.push_back(&e);
+  const core::SceneFlowParams& sf = params_.scene_flow;
+  mark_depth_edges(disp, sf.edge_margin_px, sf.edge_step_px, edges_);
+  label_stereo_flow_window(disp, disps, flows, camera_, params_.envelope, sf,
+                           camera_.frame_period(), danger, ttc, velocity, &edges_, &edges);
+  if (params_.scene_flow.exclude_ground) {
+    const GroundPlane plane = fit_ground_plane(disp, camera_, params_.scene_flow.ground);
+    cv::Mat ground;
+    mark_ground(disp, camera_, plane, params_.scene_flow.ground.tolerance_m, ground);
+    danger.setTo(0, ground);
+    ttc.setTo(std::numeric_limits<float>::quiet_NaN(), ground);
+  }
 }
 
 core::Detection Detector::process(const core::StereoFrame& frame, const FrameMaps& maps) {
@@ -21,26 +49,43 @@ core::Detection Detector::process(const core::StereoFrame& frame, const FrameMap
   if (!past_.empty() && past_.front().size() != disp.size())
     throw core::InputError("detector: the disparity map changed size within a stream");
 
-  std::vector<PastDisparity> past;
-  for (int k : params_.stereo.gaps)
-    if (k <= static_cast<int>(past_.size()))
-      past.push_back({k, &past_[static_cast<size_t>(k - 1)]});
+  const bool flow_mode = params_.mode == core::Mode::kStereoFlow;
+  if (flow_mode && !maps.flow.empty() &&
+      (maps.flow.type() != CV_32FC2 || maps.flow.size() != disp.size()))
+    throw core::InputError("detector: the flow must be a CV_32FC2 map of the disparity's size");
 
   core::Detection det;
   det.frame = frame.index;
   det.time_s = frame.time_s;
-  cv::Mat ttc;
-  label_stereo(disp, past, camera_, params_.stereo, params_.envelope, det.danger, ttc);
-  det.obstacles = extract_obstacles(det.danger, disp, ttc, camera_, params_.signal);
+  cv::Mat ttc, velocity;
+  if (flow_mode) {
+    label_flow(maps, det.danger, ttc, velocity);
+  } else {
+    std::vector<PastDisparity> past;
+    for (int k : params_.stereo.gaps)
+      if (k <= static_cast<int>(past_.size()))
+        past.push_back({k, &past_[static_cast<size_t>(k - 1)]});
+    label_stereo(disp, past, camera_, params_.stereo, params_.envelope, det.danger, ttc);
+  }
+  det.obstacles = extract_obstacles(det.danger, disp, ttc, camera_, params_.signal, velocity);
   det.regions = hysteresis_.update(count_region_pixels(det.danger, params_.signal.region_columns));
   det.signal = std::any_of(det.regions.begin(), det.regions.end(),
                            [](const core::RegionSignal& r) { return r.fired; });
   det.severity = severity_of(det.signal, det.obstacles, params_.signal);
   det.steering = steering_hint(det.regions);
 
-  const int max_gap = *std::max_element(params_.stereo.gaps.begin(), params_.stereo.gaps.end());
   past_.push_front(disp.clone());
-  while (static_cast<int>(past_.size()) > max_gap) past_.pop_back();
+  while (static_cast<int>(past_.size()) > max_gap_) past_.pop_back();
+  if (flow_mode) {
+    past_edges_.push_front(edges_.clone());
+    while (static_cast<int>(past_edges_.size()) > max_gap_) past_edges_.pop_back();
+    // The chain B_i, B_{i-1}, ... must be unbroken: a frame without flow starts it afresh.
+    if (maps.flow.empty())
+      flows_.clear();
+    else
+      flows_.push_front(maps.flow.clone());
+    while (static_cast<int>(flows_.size()) > max_gap_ - 1) flows_.pop_back();
+  }
   return det;
 }
 

@@ -47,49 +47,6 @@ void farneback(const cv::Mat& current, const cv::Mat& previous, const FlowParams
 
 }  // namespace
 
-const char* to_string(FlowMethod m) {
-  switch (m) {
-    case FlowMethod::kDisUltrafast:
-      return "dis-ultrafast";
-    case FlowMethod::kDisFast:
-      return "dis-fast";
-    case FlowMethod::kDisMedium:
-      return "dis-medium";
-    case FlowMethod::kFarneback:
-      return "farneback";
-  }
-  return "?";
-}
-
-FlowMethod parse_flow_method(const std::string& text) {
-  for (FlowMethod m : {FlowMethod::kDisUltrafast, FlowMethod::kDisFast, FlowMethod::kDisMedium,
-                       FlowMethod::kFarneback})
-    if (text == to_string(m)) return m;
-  throw core::InputError("flow.method=" + text +
-                         ": must be dis-ultrafast, dis-fast, dis-medium or farneback");
-}
-
-std::vector<std::string> validate(const FlowParams& p) {
-  std::vector<std::string> out;
-  auto require = [&out](bool ok, const char* field, auto value, const char* rule) {
-    if (ok) return;
-    std::ostringstream s;
-    s << "flow." << field << "=" << value << ": " << rule;
-    out.push_back(s.str());
-  };
-  require(p.tile_halo_px >= 0, "tile_halo_px", p.tile_halo_px, "must be >= 0");
-  if (p.method != FlowMethod::kFarneback) return out;
-  require(std::isfinite(p.fb_pyr_scale) && p.fb_pyr_scale > 0 && p.fb_pyr_scale < 1,
-          "fb_pyr_scale", p.fb_pyr_scale, "must be in (0, 1)");
-  require(p.fb_levels >= 1, "fb_levels", p.fb_levels, "must be >= 1");
-  require(p.fb_win_size >= 3, "fb_win_size", p.fb_win_size, "must be >= 3");
-  require(p.fb_iterations >= 1, "fb_iterations", p.fb_iterations, "must be >= 1");
-  require(p.fb_poly_n == 5 || p.fb_poly_n == 7, "fb_poly_n", p.fb_poly_n, "must be 5 or 7");
-  require(std::isfinite(p.fb_poly_sigma) && p.fb_poly_sigma > 0, "fb_poly_sigma", p.fb_poly_sigma,
-          "must be > 0");
-  return out;
-}
-
 FlowEstimator::FlowEstimator(const FlowParams& p) : params_(p) {
   if (p.method != FlowMethod::kFarneback) dis_ = cv::DISOpticalFlow::create(dis_preset(p.method));
 }

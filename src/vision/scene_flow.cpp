@@ -1,6 +1,7 @@
 #include "sg/vision/scene_flow.hpp"
 
 #include <algorithm>
+#include <opencv2/imgproc.hpp>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -61,7 +62,7 @@ class PixelTest {
     const cv::Vec3d Pp((q.x - cx_) * zp * inv_f_, (q.y - cy_) * zp * inv_f_, zp);
     r.velocity = (P - Pp) * (1.0 / span_s);
     r.velocity_known = true;
-    if (z > p_.z_max_m || static_cast<double>(d_cur) - d_prev < p_.min_delta_d_px ||
+    if (static_cast<double>(d_cur) - d_prev < p_.min_delta_d_px ||
         r.velocity.dot(r.velocity) > max_speed2_)
       return r;
     r.dangerous = heads_into_envelope(P, r.velocity, env_, p_.v_min_mps, r.ttc);
@@ -74,27 +75,47 @@ class PixelTest {
   const SceneFlowParams& p_;
 };
 
+/// mark_depth_edges at one pixel: the valid disparities of the window around (x, y) span more
+/// than `step`. Used for the past source q of the few pixels that pass every other test.
+bool near_depth_edge(const cv::Mat& disp, int x, int y, int r, float step) {
+  float hi = -1.0f, lo = std::numeric_limits<float>::max();
+  for (int yy = std::max(0, y - r); yy <= std::min(disp.rows - 1, y + r); ++yy) {
+    const float* row = disp.ptr<float>(yy);
+    for (int xx = std::max(0, x - r); xx <= std::min(disp.cols - 1, x + r); ++xx) {
+      if (row[xx] < 0.0f) continue;
+      hi = std::max(hi, row[xx]);
+      lo = std::min(lo, row[xx]);
+    }
+  }
+  return hi >= 0.0f && hi - lo > step;
+}
+
 }  // namespace
 
-std::vector<std::string> validate(const SceneFlowParams& p) {
-  std::vector<std::string> out;
-  auto require = [&out](bool ok, const char* field, auto value, const char* rule) {
-    if (ok) return;
-    std::ostringstream s;
-    s << "scene_flow." << field << "=" << value << ": " << rule;
-    out.push_back(s.str());
-  };
-  require(!p.gaps.empty(), "gaps", "[]", "must list at least one frame gap");
-  for (int k : p.gaps) require(k >= 1 && k <= 60, "gaps", k, "each gap must be in 1..60");
-  require(std::isfinite(p.v_min_mps) && p.v_min_mps > 0, "v_min_mps", p.v_min_mps, "must be > 0");
-  require(std::isfinite(p.z_max_m) && p.z_max_m > 0, "z_max_m", p.z_max_m, "must be > 0");
-  require(std::isfinite(p.min_delta_d_px) && p.min_delta_d_px >= 0, "min_delta_d_px",
-          p.min_delta_d_px, "must be >= 0");
-  require(p.max_speed_mps > p.v_min_mps, "max_speed_mps", p.max_speed_mps,
-          "must exceed v_min_mps");
-  require(p.max_disparity_step_px > 0, "max_disparity_step_px", p.max_disparity_step_px,
-          "must be > 0 (infinity disables)");
-  return out;
+void mark_depth_edges(const cv::Mat& disp, int margin_px, double step_px, cv::Mat& mask) {
+  if (disp.type() != CV_32FC1) throw core::InputError("depth edges: disparity must be CV_32F");
+  mask.create(disp.size(), CV_8UC1);
+  if (margin_px <= 0) {
+    mask.setTo(0);
+    return;
+  }
+  // Invalid pixels (< 0) must not count: they are already below any valid value for the maximum,
+  // and are lifted above any for the minimum.
+  cv::Mat lifted = disp.clone();
+  lifted.setTo(std::numeric_limits<float>::max(), disp < 0.0f);
+  const cv::Mat kernel =
+      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * margin_px + 1, 2 * margin_px + 1));
+  cv::Mat hi, lo;
+  cv::dilate(disp, hi, kernel, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(-1.0));
+  cv::erode(lifted, lo, kernel, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT,
+            cv::Scalar(std::numeric_limits<float>::max()));
+  const float step = static_cast<float>(step_px);
+  for (int y = 0; y < disp.rows; ++y) {
+    const float* h = hi.ptr<float>(y);
+    const float* l = lo.ptr<float>(y);
+    uint8_t* m = mask.ptr<uint8_t>(y);
+    for (int x = 0; x < disp.cols; ++x) m[x] = h[x] >= 0.0f && h[x] - l[x] > step ? 255 : 0;
+  }
 }
 
 bool sample_disparity_bilinear(const cv::Mat& disp, float x, float y, float& out,
@@ -177,7 +198,8 @@ void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const c
                               const std::vector<const cv::Mat*>& past_flows,
                               const core::Camera& cam, const core::Envelope& env,
                               const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
-                              cv::Mat& velocity) {
+                              cv::Mat& velocity, const cv::Mat* edges_cur,
+                              const std::vector<const cv::Mat*>* edges_past) {
   if (disp_cur.type() != CV_32FC1) throw core::InputError("scene flow: disparity must be CV_32F");
   const int history = static_cast<int>(std::min(past_disps.size(), past_flows.size()));
   for (int j = 0; j < history; ++j) {
@@ -197,44 +219,86 @@ void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const c
   const cv::Vec3f unknown(kNaN, kNaN, kNaN);
   const float max_step = static_cast<float>(p.max_disparity_step_px);
   const PixelTest test(cam, env, p);
+  cv::Mat own_edges;
+  if (!edges_cur) mark_depth_edges(disp_cur, p.edge_margin_px, p.edge_step_px, own_edges);
+  const cv::Mat& edges = edges_cur ? *edges_cur : own_edges;
+  check_same(disp_cur, edges, CV_8UC1, "the depth-edge mask");
+  if (edges_past) {
+    for (int k : gaps) {
+      if (k > static_cast<int>(edges_past->size()))
+        throw core::InputError("scene flow: fewer past depth-edge masks than past disparities");
+      check_same(disp_cur, *(*edges_past)[static_cast<size_t>(k - 1)], CV_8UC1,
+                 "a past depth-edge mask");
+    }
+  }
+  // The source q of gap k lies near a depth edge of D_{i-k}.
+  auto past_edge = [&](int k, cv::Point2f at) {
+    if (p.edge_margin_px <= 0) return false;
+    const int x = std::clamp(cvRound(at.x), 0, disp_cur.cols - 1);
+    const int y = std::clamp(cvRound(at.y), 0, disp_cur.rows - 1);
+    if (edges_past) return (*edges_past)[static_cast<size_t>(k - 1)]->at<uint8_t>(y, x) != 0;
+    return near_depth_edge(*past_disps[static_cast<size_t>(k - 1)], x, y, p.edge_margin_px,
+                           static_cast<float>(p.edge_step_px));
+  };
 
-  // Row by row, step-major: every pixel of the row advances its chain by one flow before the
-  // next step, so the independent chains overlap instead of waiting on one another.
+  const float d_min = static_cast<float>(cam.focal_px * cam.baseline_m / p.z_max_m);
+  auto in_band = [&cam, &env](int y, float d) {
+    const double Y = (y - cam.cy) * cam.baseline_m / d;  // (y - cy) * Z / f
+    return Y >= env.y_top_m && Y <= env.y_bottom_m;
+  };
+
+  // Row by row, step-major: every live pixel of the row advances its chain by one flow before the
+  // next step, so the independent chains overlap instead of waiting on one another. Only
+  // candidates are followed (the chains are the cost of the labelling), kept in a compact list.
   std::vector<cv::Point2f> q(disp_cur.cols);
-  std::vector<uint8_t> alive(disp_cur.cols);
+  std::vector<int> live;
+  live.reserve(disp_cur.cols);
   for (int y = 0; y < disp_cur.rows; ++y) {
     const float* d_row = disp_cur.ptr<float>(y);
+    const uint8_t* edge_row = edges.ptr<uint8_t>(y);
     uint8_t* danger_row = danger.ptr<uint8_t>(y);
     float* ttc_row = ttc.ptr<float>(y);
     cv::Vec3f* vel_row = velocity.ptr<cv::Vec3f>(y);
+    live.clear();
     for (int x = 0; x < disp_cur.cols; ++x) {
       danger_row[x] = 0;
       ttc_row[x] = kNaN;
       vel_row[x] = unknown;
-      q[x] = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
-      alive[x] = d_row[x] > 0.0f;
+      if (d_row[x] > 0.0f && d_row[x] >= d_min && edge_row[x] == 0 &&
+          (!p.use_envelope_band || in_band(y, d_row[x]))) {
+        q[x] = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
+        live.push_back(x);
+      }
     }
     int step = 0;
     for (int k : gaps) {
-      for (; step < k; ++step) {
+      for (; step < k && !live.empty(); ++step) {
         const cv::Mat& flow = *past_flows[step];
-        for (int x = 0; x < disp_cur.cols; ++x) {
-          if (!alive[x]) continue;
-          cv::Vec2f f(0.0f, 0.0f);
+        size_t kept = 0;
+        for (const int x : live) {
+          cv::Vec2f f;
           // A point that left the image is lost for every longer gap too.
-          alive[x] = sample_flow_bilinear(flow, q[x].x, q[x].y, f);
+          if (!sample_flow_bilinear(flow, q[x].x, q[x].y, f)) continue;
           q[x] += cv::Point2f(f[0], f[1]);
+          live[kept++] = x;
         }
+        live.resize(kept);
       }
+      if (live.empty()) break;
       const cv::Mat& past = *past_disps[k - 1];
-      for (int x = 0; x < disp_cur.cols; ++x) {
+      for (const int x : live) {
         float d_prev;
-        if (!alive[x] || !sample_disparity_bilinear(past, q[x].x, q[x].y, d_prev, max_step))
-          continue;
+        if (!sample_disparity_bilinear(past, q[x].x, q[x].y, d_prev, max_step)) continue;
         const GapResult r =
             test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x], d_prev, k * dt);
         if (!r.velocity_known) continue;
-        if (r.dangerous) {
+        const bool dangerous = r.dangerous && !past_edge(k, q[x]);
+        if (p.longest_gap_decides) {
+          // Gaps ascend: each known estimate replaces those of the shorter, noisier gaps.
+          danger_row[x] = dangerous ? 255 : 0;
+          ttc_row[x] = dangerous ? static_cast<float>(r.ttc) : kNaN;
+          vel_row[x] = cv::Vec3f(r.velocity);
+        } else if (dangerous) {
           if (danger_row[x] == 0 || r.ttc < ttc_row[x]) {
             ttc_row[x] = static_cast<float>(r.ttc);
             vel_row[x] = cv::Vec3f(r.velocity);

@@ -5,6 +5,8 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
+#include "sg/core/error.hpp"
+
 namespace sg::vision {
 namespace {
 
@@ -22,13 +24,19 @@ struct Blob {
   cv::Point first{-1, -1};  ///< first pixel in raster order
   std::vector<double> depths;
   std::vector<double> ttcs;
+  cv::Vec3d velocity_sum{0.0, 0.0, 0.0};
+  int velocity_count = 0;
 };
 
 }  // namespace
 
 std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp,
                                               const cv::Mat& ttc, const core::Camera& camera,
-                                              const core::SignalParams& p) {
+                                              const core::SignalParams& p,
+                                              const cv::Mat& velocity) {
+  const bool with_velocity = !velocity.empty();
+  if (with_velocity && (velocity.type() != CV_32FC3 || velocity.size() != mask.size()))
+    throw core::InputError("obstacles: the velocity map must be CV_32FC3 of the mask's size");
   if (p.open_size > 1) {
     const cv::Mat kernel =
         cv::getStructuringElement(cv::MORPH_RECT, cv::Size(p.open_size, p.open_size));
@@ -43,6 +51,7 @@ std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp
     const int* lab = labels.ptr<int>(y);
     const float* d = disp.ptr<float>(y);
     const float* t = ttc.ptr<float>(y);
+    const cv::Vec3f* v = with_velocity ? velocity.ptr<cv::Vec3f>(y) : nullptr;
     uchar* m = mask.ptr<uchar>(y);
     for (int x = 0; x < mask.cols; ++x) {
       const int l = lab[x];
@@ -55,6 +64,10 @@ std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp
       if (b.first.x < 0) b.first = {x, y};
       if (d[x] > 0.0f) b.depths.push_back(camera.depth(d[x]));
       if (std::isfinite(t[x])) b.ttcs.push_back(t[x]);
+      if (v && std::isfinite(v[x][0]) && std::isfinite(v[x][1]) && std::isfinite(v[x][2])) {
+        b.velocity_sum += cv::Vec3d(v[x]);
+        ++b.velocity_count;
+      }
     }
   }
 
@@ -78,6 +91,7 @@ std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp
     o.pixels = stats.at<int>(l, cv::CC_STAT_AREA);
     o.distance_m = b.depths.empty() ? 0.0 : median_of(b.depths);
     if (!b.ttcs.empty()) o.ttc_s = median_of(b.ttcs);
+    if (b.velocity_count > 0) o.velocity = b.velocity_sum * (1.0 / b.velocity_count);
     out.push_back(o);
   }
   return out;

@@ -2,10 +2,13 @@
 // user error, valid event lines whatever happens, reproducible output.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <sstream>
 #include <string>
@@ -224,6 +227,208 @@ TEST_F(Cli, EvalWithoutGroundTruth) {
   const fs::path folder = small_folder(3);
   fs::remove_all(folder / "gt");
   expect_user_error(run("eval --input '" + folder.string() + "'"), "ground truth");
+}
+
+}  // namespace
+
+namespace {
+
+TEST_F(Cli, BenchWritesOneCsvRowPerConfigurationBesideItsBaselines) {
+  const Result r = run(
+      "bench --modes stereo --workers 1,2 --tiles 1,3 --resolutions 161x121 --frames 12 "
+      "--pace 2 --csv b.csv --plot b.png");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream csv(dir_ / "b.csv");
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(csv, line);) rows.push_back(line);
+  // header, baseline, opencv-mt, 4 pipeline configurations, 1 paced run
+  ASSERT_EQ(rows.size(), 8u) << r.out;
+  EXPECT_EQ(rows[0].rfind("kind,mode,width,height,workers,tiles", 0), 0u);
+  EXPECT_EQ(rows[1].rfind("baseline,stereo,161,121,", 0), 0u) << rows[1];
+  EXPECT_EQ(rows[2].rfind("opencv-mt,stereo,161,121,", 0), 0u) << rows[2];
+  for (int i = 3; i < 7; ++i) {
+    EXPECT_EQ(rows[i].rfind("pipeline,stereo,161,121,", 0), 0u) << rows[i];
+    // Every configuration detects exactly what the plain loop detects.
+    EXPECT_EQ(rows[i].substr(rows[i].rfind(',') + 1), "yes") << rows[i];
+  }
+  EXPECT_EQ(rows[7].rfind("paced,stereo,161,121,", 0), 0u) << rows[7];
+  EXPECT_GT(fs::file_size(dir_ / "b.png"), 1000u);
+}
+
+TEST_F(Cli, BenchRejectsBadSettings) {
+  expect_user_error(run("bench --resolutions 640by480"), "640by480");
+  expect_user_error(run("bench --workers 0 --frames 12"), "workers=0");
+}
+
+}  // namespace
+
+namespace {
+
+TEST_F(Cli, CorruptPngWithParallelPipelineIsStillACleanError) {
+  const fs::path folder = small_folder(8);
+  std::ofstream(folder / "left" / "000005.png", std::ios::binary) << "not a png";
+  const fs::path events = dir_ / "events.jsonl";
+  const Result r = run("run --workers 2 --tiles 3 --input '" + folder.string() + "' --events '" +
+                       events.string() + "'");
+  expect_user_error(r, "000005.png");
+  const auto lines = read_events(events);  // complete lines only, in order
+  EXPECT_LE(lines.size(), 5u);
+  for (size_t i = 0; i < lines.size(); ++i) EXPECT_EQ(lines[i]["frame"], i);
+}
+
+TEST_F(Cli, InvalidParallelOptions) {
+  expect_user_error(run("run --scenario '" + small_scenario().string() + "' --workers 0"),
+                    "workers=0");
+  expect_user_error(run("run --scenario '" + small_scenario().string() + "' --tiles 100"),
+                    "tiles=100");
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Stereo-Flow mode and `eval --flow`
+
+namespace {
+
+/// Middlebury .flo: "PIEH" (202021.25 as float), width, height, then (u, v) floats row by row.
+void write_flo_file(const fs::path& p, const cv::Mat& flow) {
+  std::ofstream out(p, std::ios::binary);
+  const float tag = 202021.25f;
+  const int32_t w = flow.cols, h = flow.rows;
+  out.write(reinterpret_cast<const char*>(&tag), 4);
+  out.write(reinterpret_cast<const char*>(&w), 4);
+  out.write(reinterpret_cast<const char*>(&h), 4);
+  for (int y = 0; y < h; ++y) out.write(flow.ptr<char>(y), static_cast<std::streamsize>(w) * 8);
+}
+
+/// A smooth random texture and the same moved by (dx, dy) px: GT forward flow (dx, dy).
+void write_shifted_pair(const fs::path& a, const fs::path& b, const fs::path& gt, cv::Size size,
+                        int dx, int dy) {
+  cv::RNG rng(77);
+  cv::Mat big(size.height + 40, size.width + 40, CV_8U);
+  rng.fill(big, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat smooth;
+  cv::GaussianBlur(big, smooth, cv::Size(0, 0), 1.5);
+  cv::normalize(smooth, smooth, 0, 255, cv::NORM_MINMAX);
+  const cv::Rect r(20, 20, size.width, size.height);
+  cv::imwrite(a.string(), smooth(r));
+  cv::imwrite(b.string(), smooth(r - cv::Point(dx, dy)));  // content moves by (+dx, +dy)
+  write_flo_file(gt, cv::Mat(size, CV_32FC2, cv::Scalar(dx, dy)));
+}
+
+/// EPE of `method` in the table that `eval --flow` prints for `pair`; -1 when absent.
+double printed_epe(const std::string& out, const std::string& pair, const std::string& method) {
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::string p, m;
+    double epe = -1;
+    if (words >> p >> m >> epe && p == pair && m == method) return epe;
+  }
+  return -1;
+}
+
+TEST_F(Cli, StereoFlowRepeatedRunsGiveByteIdenticalEventsWithVelocities) {
+  const std::string scenario = small_scenario(24).string();
+  const std::string common = "run --quiet --no-timing --mode stereo-flow --scenario '" + scenario;
+  ASSERT_EQ(run(common + "' --events a.jsonl").status, 0);
+  ASSERT_EQ(run(common + "' --events b.jsonl --workers 2").status, 0);
+  const std::string a = slurp(dir_ / "a.jsonl");
+  EXPECT_EQ(a, slurp(dir_ / "b.jsonl"));
+  const auto events = read_events(dir_ / "a.jsonl");
+  ASSERT_EQ(events.size(), 24u);
+  // The box approaches at 3 m/s: by the end it is an obstacle with a velocity towards us.
+  int with_velocity = 0;
+  for (const auto& e : events)
+    for (const auto& o : e["obstacles"])
+      if (o.contains("velocity_mps")) {
+        ++with_velocity;
+        EXPECT_LT(o["velocity_mps"][2].get<double>(), -1.5) << e.dump();
+      }
+  EXPECT_GT(with_velocity, 5);
+}
+
+TEST_F(Cli, FlowMethodFlagAndConfigSection) {
+  const std::string scenario = small_scenario(6).string();
+  EXPECT_EQ(run("run --quiet --mode stereo-flow --flow-method farneback --scenario '" + scenario +
+                "'")
+                .status,
+            0);
+  expect_user_error(run("run --mode stereo-flow --flow-method dis --scenario '" + scenario + "'"),
+                    "flow.method=dis");
+  std::ofstream(dir_ / "bad.yaml") << "mode: stereo-flow\nscene_flow:\n  v_min_mps: -1\n";
+  expect_user_error(run("run --config bad.yaml --scenario '" + scenario + "'"),
+                    "scene_flow.v_min_mps=-1");
+}
+
+TEST_F(Cli, EvalFlowOnASyntheticPairAndFolders) {
+  write_shifted_pair(dir_ / "a.png", dir_ / "b.png", dir_ / "gt.flo", {161, 121}, 3, -2);
+  Result r = run("eval --flow --left a.png --right b.png --gt gt.flo --json flow.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* m : {"dis-ultrafast", "dis-fast", "dis-medium", "farneback"}) {
+    const double epe = printed_epe(r.out, "a", m);
+    EXPECT_GE(epe, 0.0) << m << "\n" << r.out;
+    EXPECT_LT(epe, 1.0) << m;  // zero flow would be 3.6 px
+  }
+  const auto j = nlohmann::json::parse(slurp(dir_ / "flow.json"));
+  EXPECT_EQ(j["flow"].size(), 4u);
+  // Folder forms: Middlebury (NAME1, NAME2, NAME.flo) in a subfolder, FlyingChairs beside it.
+  fs::create_directories(dir_ / "d" / "Shift");
+  write_shifted_pair(dir_ / "d" / "Shift" / "Shift1.png", dir_ / "d" / "Shift" / "Shift2.png",
+                     dir_ / "d" / "Shift" / "Shift.flo", {97, 75}, -2, 1);
+  write_shifted_pair(dir_ / "d" / "0000007-img0.pgm", dir_ / "d" / "0000007-img1.pgm",
+                     dir_ / "d" / "0000007-gt.flo", {97, 75}, 1, 2);
+  r = run("eval --flow --dir d --flow-methods dis-medium");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_GE(printed_epe(r.out, "Shift", "dis-medium"), 0.0) << r.out;
+  EXPECT_LT(printed_epe(r.out, "Shift", "dis-medium"), 1.0) << r.out;
+  EXPECT_GE(printed_epe(r.out, "0000007", "dis-medium"), 0.0) << r.out;
+  EXPECT_GE(printed_epe(r.out, "mean", "dis-medium"), 0.0) << r.out;
+  EXPECT_LT(printed_epe(r.out, "0000007", "farneback"), 0.0);  // not asked for
+}
+
+TEST_F(Cli, EvalFlowBadInput) {
+  write_shifted_pair(dir_ / "a.png", dir_ / "b.png", dir_ / "gt.flo", {161, 121}, 3, 0);
+  write_shifted_pair(dir_ / "s.png", dir_ / "t.png", dir_ / "small.flo", {81, 61}, 3, 0);
+  expect_user_error(run("eval --flow --left a.png --right missing.png --gt gt.flo"), "missing.png");
+  expect_user_error(run("eval --flow --left a.png --right b.png --gt small.flo"), "sizes differ");
+  std::ofstream(dir_ / "bad.flo", std::ios::binary) << "not a flo file at all";
+  expect_user_error(run("eval --flow --left a.png --right b.png --gt bad.flo"), "bad.flo");
+  expect_user_error(run("eval --flow --left a.png --right b.png"), "--gt");
+  expect_user_error(run("eval --flow --dir nowhere"), "nowhere");
+  fs::create_directories(dir_ / "empty");
+  expect_user_error(run("eval --flow --dir empty"), "no pair found");
+  expect_user_error(
+      run("eval --flow --left a.png --right b.png --gt gt.flo --flow-methods dis-slow"),
+      "dis-slow");
+}
+
+// DIS on real data (the acceptance): skipped when the shared data is absent.
+TEST_F(Cli, EvalFlowOnMiddleburyAndFlyingChairs) {
+  const fs::path data = fs::path(SG_SHARED_DIR) / "data";
+  const fs::path rw = data / "middlebury_flow" / "RubberWhale";
+  const fs::path fc = data / "flyingchairs_examples";
+  if (!fs::exists(rw / "RubberWhale.flo") || !fs::exists(fc / "0000000-gt.flo"))
+    GTEST_SKIP() << "no shared flow data under " << data;
+  Result r = run("eval --flow --dir '" + rw.string() + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::printf("%s", r.out.c_str());
+  // RubberWhale moves by at most a few px: every DIS preset stays well under 1 px, and the finer
+  // presets are not worse than ultrafast.
+  const double ultrafast = printed_epe(r.out, "RubberWhale", "dis-ultrafast");
+  const double medium = printed_epe(r.out, "RubberWhale", "dis-medium");
+  EXPECT_GT(ultrafast, 0.0);
+  EXPECT_LT(ultrafast, 1.0);
+  EXPECT_GT(medium, 0.0);
+  EXPECT_LE(medium, ultrafast);
+  r = run("eval --flow --dir '" + fc.string() + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::printf("%s", r.out.c_str());
+  for (const char* m : {"dis-ultrafast", "dis-fast", "dis-medium"}) {
+    const double epe = printed_epe(r.out, "mean", m);
+    EXPECT_GT(epe, 0.0) << m;
+    EXPECT_LT(epe, 8.0) << m;  // large chair motions; zero flow is about 10 px here
+  }
 }
 
 }  // namespace

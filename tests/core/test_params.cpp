@@ -63,5 +63,33 @@ TEST(Params, ParseMode) {
   EXPECT_THROW(parse_mode("mono"), InputError);
 }
 
+TEST(Params, FlowAndSceneFlowAreValidated) {
+  DetectorParams p;
+  p.flow.method = FlowMethod::kFarneback;
+  p.flow.fb_poly_n = 6;
+  p.scene_flow.gaps = {1, 0};
+  p.scene_flow.edge_margin_px = -1;
+  p.scene_flow.exclude_ground = true;
+  p.scene_flow.ground.lower_fraction = 0.0;
+  const auto problems = validate(p, Camera{});
+  EXPECT_TRUE(mentions(problems, "flow.fb_poly_n=6"));
+  EXPECT_TRUE(mentions(problems, "scene_flow.gaps=0"));
+  EXPECT_TRUE(mentions(problems, "scene_flow.edge_margin_px=-1"));
+  EXPECT_TRUE(mentions(problems, "ground.lower_fraction=0"));
+  // Farneback settings are not checked for DIS; the ground only when it is used.
+  p.flow.method = FlowMethod::kDisFast;
+  p.scene_flow.exclude_ground = false;
+  const auto fewer = validate(p, Camera{});
+  EXPECT_FALSE(mentions(fewer, "flow.fb_poly_n"));
+  EXPECT_FALSE(mentions(fewer, "ground."));
+}
+
+TEST(Params, FlowMethodNames) {
+  for (FlowMethod m : {FlowMethod::kDisUltrafast, FlowMethod::kDisFast, FlowMethod::kDisMedium,
+                       FlowMethod::kFarneback})
+    EXPECT_EQ(parse_flow_method(to_string(m)), m);
+  EXPECT_THROW(parse_flow_method("DIS"), InputError);
+}
+
 }  // namespace
 }  // namespace sg::core

@@ -41,6 +41,51 @@ TEST(Config, SetsOnlyTheGivenFields) {
   EXPECT_DOUBLE_EQ(p.envelope.horizon_s, defaults.envelope.horizon_s);
 }
 
+TEST(Config, FlowAndSceneFlowSections) {
+  ScratchDir dir;
+  const auto path = write_file(dir,
+                               "flow: {method: farneback, fb_levels: 4}\n"
+                               "scene_flow:\n"
+                               "  gaps: [2, 6]\n"
+                               "  v_min_mps: 0.5\n"
+                               "  z_max_m: 15\n"
+                               "  edge_margin_px: 3\n"
+                               "  longest_gap_decides: false\n"
+                               "  exclude_ground: true\n"
+                               "  ground: {tolerance_m: 0.1, min_inliers: 50}\n");
+  core::DetectorParams p;
+  RunSettings s;
+  apply_config_file(path, p, s);
+  EXPECT_EQ(p.flow.method, core::FlowMethod::kFarneback);
+  EXPECT_EQ(p.flow.fb_levels, 4);
+  EXPECT_EQ(p.scene_flow.gaps, (std::vector<int>{2, 6}));
+  EXPECT_DOUBLE_EQ(p.scene_flow.v_min_mps, 0.5);
+  EXPECT_DOUBLE_EQ(p.scene_flow.z_max_m, 15.0);
+  EXPECT_EQ(p.scene_flow.edge_margin_px, 3);
+  EXPECT_FALSE(p.scene_flow.longest_gap_decides);
+  EXPECT_TRUE(p.scene_flow.exclude_ground);
+  EXPECT_DOUBLE_EQ(p.scene_flow.ground.tolerance_m, 0.1);
+  EXPECT_EQ(p.scene_flow.ground.min_inliers, 50);
+  const core::DetectorParams defaults;
+  EXPECT_EQ(p.scene_flow.use_envelope_band, defaults.scene_flow.use_envelope_band);
+  EXPECT_EQ(p.stereo.gaps, defaults.stereo.gaps);  // Stereo mode's gaps are another section
+}
+
+TEST(Config, BadFlowMethodAndUnknownSceneFlowKeysAreNamed) {
+  ScratchDir dir;
+  core::DetectorParams p;
+  RunSettings s;
+  auto path = write_file(dir, "flow: {method: lucas-kanade}\n");
+  std::string message = input_error_of([&] { apply_config_file(path, p, s); });
+  EXPECT_NE(message.find("flow.method=lucas-kanade"), std::string::npos) << message;
+  path = write_file(dir, "scene_flow: {ground: {tolerance: 0.1}}\n");
+  message = input_error_of([&] { apply_config_file(path, p, s); });
+  EXPECT_NE(message.find("scene_flow.ground.tolerance"), std::string::npos) << message;
+  path = write_file(dir, "scene_flow: {gaps: one}\n");
+  message = input_error_of([&] { apply_config_file(path, p, s); });
+  EXPECT_NE(message.find("scene_flow.gaps"), std::string::npos) << message;
+}
+
 TEST(Config, EmptyFileChangesNothing) {
   ScratchDir dir;
   core::DetectorParams p;

@@ -67,6 +67,22 @@ TEST(Overlay, RegionCellsAndBoxColours) {
   EXPECT_EQ(out.at<cv::Vec3b>(60, 20), cv::Vec3b(0, 0, 255));  // left edge of the box
 }
 
+TEST(Overlay, VelocityAddsASecondLabelLine) {
+  core::Detection plain = sample_detection(3);
+  core::Detection with_velocity = plain;
+  with_velocity.obstacles[0].velocity = cv::Vec3d(0.1, 0.0, -3.0);
+  const cv::Mat a = draw_overlay(flat_frame(3, 100), plain);
+  const cv::Mat b = draw_overlay(flat_frame(3, 100), with_velocity);
+  auto black = [](const cv::Mat& img) {
+    cv::Mat mask;
+    cv::inRange(img, cv::Scalar(0, 0, 0), cv::Scalar(0, 0, 0), mask);
+    return cv::countNonZero(mask);
+  };
+  // The label's black background is one line taller: by about one text height times the width
+  // of the label.
+  EXPECT_GT(black(b), black(a) + 5 * 20);
+}
+
 TEST(Overlay, NoRegionsNoDangerStillDraws) {
   core::Detection d;
   const cv::Mat out = draw_overlay(flat_frame(0, 50), d);

@@ -130,10 +130,117 @@ TEST(Detector, GapUsesTheFrameExactlyKFramesAgo) {
   EXPECT_NEAR(*out[3].obstacles[0].ttc_s, 0.9 * (z - 0.5) / z, 1e-6);
 }
 
-TEST(Detector, StereoFlowModeIsNotAvailableYet) {
-  core::DetectorParams params;
-  params.mode = core::Mode::kStereoFlow;
-  EXPECT_THROW(Detector(params, camera()), core::InputError);
+// ---------------------------------------------------------------------------------------------
+// Stereo-Flow mode
+
+core::DetectorParams flow_params() {
+  core::DetectorParams p;
+  p.mode = core::Mode::kStereoFlow;
+  return p;
+}
+
+/// The patch of kPatch moved by `shift_x` px since the last frame: backward flow (-shift_x, 0) on
+/// it, zero elsewhere (the background does not move).
+cv::Mat patch_flow(cv::Rect patch, float shift_x) {
+  const core::Camera cam = camera();
+  cv::Mat f(cam.height, cam.width, CV_32FC2, cv::Scalar(0, 0));
+  f(patch).setTo(cv::Scalar(-shift_x, 0));
+  return f;
+}
+
+TEST(DetectorStereoFlow, HeadOnPatchFiresWithItsVelocity) {
+  const core::DetectorParams params = flow_params();
+  Detector det(params, camera());
+  cv::RNG rng(11);
+  std::vector<core::Detection> out;
+  for (int i = 0; i < 16; ++i) {
+    // 6 m -> 2.25 m at 2.5 m/s; every point moves along its ray, so the flow is zero.
+    const double z = 6.0 - 0.25 * i;
+    FrameMaps maps{scene(z, rng, 0.1), i == 0 ? cv::Mat() : patch_flow(kPatch, 0.0f)};
+    out.push_back(det.process(frame(i), maps));
+  }
+  EXPECT_FALSE(out[0].signal);
+  EXPECT_EQ(cv::countNonZero(out[0].danger), 0);  // no history yet
+  // Gap 1 sees 0.36 px a frame, below min_delta_d_px; gap 4 (from frame 4) sees 1.7 px. With
+  // on_k = 2 the signal is on from frame 5 to the end.
+  for (int i = 0; i < 16; ++i) EXPECT_EQ(out[i].signal, i >= 5) << "frame " << i;
+  const core::Detection& last = out[15];
+  ASSERT_TRUE(last.signal);
+  EXPECT_TRUE(last.regions[1].fired);
+  EXPECT_FALSE(last.regions[0].fired);
+  ASSERT_EQ(last.obstacles.size(), 1u);
+  const core::Obstacle& o = last.obstacles[0];
+  // Pixels within edge_margin_px of the patch's border are not labelled.
+  EXPECT_TRUE(kPatch.contains(o.bbox.tl()));
+  EXPECT_LE(o.bbox.width, kPatch.width - 2 * params.scene_flow.edge_margin_px);
+  ASSERT_TRUE(o.velocity.has_value());
+  EXPECT_NEAR((*o.velocity)[2], -2.5, 0.3);
+  EXPECT_LT(std::abs((*o.velocity)[0]), 0.5);
+  EXPECT_LT(std::abs((*o.velocity)[1]), 0.5);
+  ASSERT_TRUE(o.ttc_s.has_value());
+  const double z = 6.0 - 0.25 * 15;
+  EXPECT_NEAR(*o.ttc_s, (z - params.envelope.z_contact_m) / 2.5, 0.3);
+}
+
+// The point of the mode: a patch crossing at constant depth. Stereo mode flags its leading edge
+// (the disparity there jumps from the background's to the patch's); Stereo-Flow mode follows the
+// flow and finds a sideways motion.
+TEST(DetectorStereoFlow, CrossingPatchNeverFiresWhereStereoModeDoes) {
+  core::DetectorParams stereo_params;
+  stereo_params.stereo.gaps = {1};
+  Detector flow_det(flow_params(), camera()), stereo_det(stereo_params, camera());
+  cv::RNG rng(12);
+  const core::Camera cam = camera();
+  int stereo_alarms = 0;
+  for (int i = 0; i < 16; ++i) {
+    const cv::Rect patch(5 + 6 * i, 45, 40, 31);  // 2.4 m/s at 4 m
+    // A wall 6 m away behind it, near enough for Stereo mode's max_growth rule to let the edge by.
+    cv::Mat d(cam.height, cam.width, CV_32F, cv::Scalar(cam.disparity(6.0)));
+    d(patch).setTo(cam.disparity(4.0));
+    for (int y = 0; y < d.rows; ++y)
+      for (int x = 0; x < d.cols; ++x)
+        d.at<float>(y, x) += static_cast<float>(rng.uniform(-0.1, 0.1));
+    const core::Detection f =
+        flow_det.process(frame(i), {d, i == 0 ? cv::Mat() : patch_flow(patch, 6.0f)});
+    EXPECT_FALSE(f.signal) << "frame " << i;
+    EXPECT_EQ(cv::countNonZero(f.danger), 0) << "frame " << i;
+    stereo_alarms += stereo_det.process(frame(i), {d, {}}).signal;
+  }
+  EXPECT_GT(stereo_alarms, 5);
+}
+
+TEST(DetectorStereoFlow, GapsNeedAnUnbrokenChainOfFlows) {
+  core::DetectorParams params = flow_params();
+  params.scene_flow.gaps = {2};
+  params.signal.on_k = 1;
+  params.signal.on_n = 1;
+  Detector det(params, camera());
+  cv::RNG rng(13);
+  std::vector<bool> dangerous;
+  for (int i = 0; i < 6; ++i) {
+    const double z = 5.0 - 0.3 * i;
+    // Frame 3 comes without flow (as after a dropped frame): gap 2 is unavailable at frames 3, 4.
+    const bool no_flow = i == 0 || i == 3;
+    const core::Detection d =
+        det.process(frame(i), {scene(z, rng, 0.05), no_flow ? cv::Mat() : patch_flow(kPatch, 0)});
+    dangerous.push_back(cv::countNonZero(d.danger) > 0);
+  }
+  EXPECT_FALSE(dangerous[0]);
+  EXPECT_FALSE(dangerous[1]);  // one frame of history
+  EXPECT_TRUE(dangerous[2]);
+  EXPECT_FALSE(dangerous[3]);
+  EXPECT_FALSE(dangerous[4]);
+  EXPECT_TRUE(dangerous[5]);
+}
+
+TEST(DetectorStereoFlow, BadFlowIsAnInputError) {
+  Detector det(flow_params(), camera());
+  cv::RNG rng(14);
+  det.process(frame(0), {scene(5.0, rng), {}});
+  EXPECT_THROW(det.process(frame(1), {scene(5.0, rng), cv::Mat(121, 161, CV_32FC1)}),
+               core::InputError);
+  EXPECT_THROW(det.process(frame(1), {scene(5.0, rng), cv::Mat(120, 161, CV_32FC2)}),
+               core::InputError);
 }
 
 TEST(Detector, DisparitySizeChangeIsAnInputError) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -183,6 +184,17 @@ TEST(SceneFlowParams, Validate) {
 
 constexpr double kDt = 1.0 / 30.0;
 
+/// The thesis' test alone: no depth-edge margin, no band, far range, any gap flags. The filters
+/// added for real matchers have their own tests below.
+SceneFlowParams plain() {
+  SceneFlowParams p;
+  p.edge_margin_px = 0;
+  p.use_envelope_band = false;
+  p.longest_gap_decides = false;
+  p.z_max_m = 50.0;
+  return p;
+}
+
 /// Background: a wall at 20 m (d = 1 px for f B = 20), flow zero.
 struct Maps {
   cv::Mat cur, prev, flow;
@@ -203,7 +215,7 @@ TEST(LabelStereoFlow, HeadOnPatchIsDangerous) {
   m.prev(patch).setTo(20.0 / 2.0);
   m.cur(patch).setTo(20.0 / 1.9);
   cv::Mat danger, ttc, vel;
-  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, {}, kDt, danger, ttc, vel);
+  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, plain(), kDt, danger, ttc, vel);
   ASSERT_EQ(danger.type(), CV_8UC1);
   ASSERT_EQ(ttc.type(), CV_32FC1);
   ASSERT_EQ(vel.type(), CV_32FC3);
@@ -234,7 +246,7 @@ TEST(LabelStereoFlow, CrossingPatchIsSafeEvenAtItsEdges) {
   const cv::Point leading_edge(now.br().x - 2, now.y + 10);
   ASSERT_GE(m.cur.at<float>(leading_edge) - m.prev.at<float>(leading_edge), 0.5f);
   cv::Mat danger, ttc, vel;
-  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, {}, kDt, danger, ttc, vel);
+  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, plain(), kDt, danger, ttc, vel);
   EXPECT_EQ(cv::countNonZero(danger), 0);
   const cv::Vec3f v = vel.at<cv::Vec3f>(leading_edge);
   EXPECT_NEAR(v[0], shift * 2.0 / cam.focal_px / kDt, 1e-3);  // 1.8 m/s sideways
@@ -247,12 +259,12 @@ TEST(LabelStereoFlow, UnknownWhereTheFlowLeavesTheImage) {
   m.flow.setTo(cv::Scalar(-3, 0));
   m.cur.at<float>(10, 20) = -1.0f;
   cv::Mat danger, ttc, vel;
-  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, {}, kDt, danger, ttc, vel);
+  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, plain(), kDt, danger, ttc, vel);
   EXPECT_TRUE(std::isnan(vel.at<cv::Vec3f>(10, 2)[0]));   // q.x = -1
   EXPECT_FALSE(std::isnan(vel.at<cv::Vec3f>(10, 3)[0]));  // q.x = 0
   EXPECT_TRUE(std::isnan(vel.at<cv::Vec3f>(10, 20)[2]));  // D_i invalid
-  EXPECT_THROW(label_stereo_flow(m.cur, m.prev(cv::Rect(0, 0, 10, 10)), m.flow, cam, {}, {}, kDt,
-                                 danger, ttc, vel),
+  EXPECT_THROW(label_stereo_flow(m.cur, m.prev(cv::Rect(0, 0, 10, 10)), m.flow, cam, {}, plain(),
+                                 kDt, danger, ttc, vel),
                core::InputError);
 }
 
@@ -295,9 +307,12 @@ NaiveOut naive_pixel(int x, int y, const cv::Mat& cur, const std::vector<cv::Mat
   const double d = cur.at<float>(y, x);
   if (!(d > 0)) return out;
   const double z = c.focal_px * c.baseline_m / d;
+  if (z > p.z_max_m) return out;  // not a candidate: velocity unknown
   const cv::Vec3d P((x - c.cx) * z / c.focal_px, (y - c.cy) * z / c.focal_px, z);
   int best_valid_gap = 0;
-  for (int k : gaps) {
+  std::vector<int> ascending = gaps;
+  std::sort(ascending.begin(), ascending.end());
+  for (int k : ascending) {
     if (k > static_cast<int>(disps.size())) continue;
     double qx = x, qy = y;
     bool ok = true;
@@ -322,6 +337,12 @@ NaiveOut naive_pixel(int x, int y, const cv::Mat& cur, const std::vector<cv::Mat
       const double X = P[0] + V[0] * tc, Y = P[1] + V[1] * tc;
       flag = tc > 0 && tc <= e.horizon_s && std::abs(X) <= e.half_width_m && Y >= e.y_top_m &&
              Y <= e.y_bottom_m;
+    }
+    if (p.longest_gap_decides) {  // ascending: the last known gap wins
+      out.danger = flag;
+      out.ttc = flag ? tc : NAN;
+      out.vel = V;
+      continue;
     }
     if (flag && (!out.danger || tc < out.ttc)) {
       out.ttc = tc;
@@ -356,7 +377,8 @@ cv::Mat random_flow(cv::Size size, double amplitude, cv::RNG& rng) {
   return big(cv::Rect(2, 1, size.width, size.height));
 }
 
-void compare_with_naive(const std::vector<int>& gaps, int history, uint64_t seed) {
+void compare_with_naive(const std::vector<int>& gaps, int history, uint64_t seed,
+                        bool longest = false) {
   core::Camera cam = odd_camera();
   cam.width = 63;
   cam.height = 49;
@@ -367,7 +389,9 @@ void compare_with_naive(const std::vector<int>& gaps, int history, uint64_t seed
   env.half_width_m = 1.5;
   env.y_top_m = -1.5;
   env.y_bottom_m = 1.5;
-  SceneFlowParams p;
+  SceneFlowParams p = plain();
+  p.longest_gap_decides = longest;
+  p.z_max_m = 2.0;  // some of the random points (0.67 .. 2.5 m) lie beyond
   p.gaps = gaps;
   p.min_delta_d_px = 0.2;
   p.max_disparity_step_px = 1.5;
@@ -423,6 +447,10 @@ TEST(LabelStereoFlowWindow, MatchesNaiveReferenceOnRandomMaps) {
   compare_with_naive({1, 2, 5}, 3, 6);  // gap 5 lacks history and is skipped
 }
 
+TEST(LabelStereoFlowWindow, LongestGapDecidesMatchesNaiveReference) {
+  for (uint64_t seed : {7u, 8u}) compare_with_naive({3, 1, 2}, 3, seed, true);
+}
+
 // A fronto-parallel 0.6 m square on the optical axis approaching at 3 m/s from 9 m: it reaches
 // z_contact in 8.5 / 3 = 2.83 s, within the horizon, but its disparity grows by only 0.07 px per
 // frame, below min_delta_d_px = 0.5 (and below stereo noise). Over 10 frames it grows by 0.67 px.
@@ -465,7 +493,7 @@ class FarApproach : public ::testing::Test {
       d.push_back(&disps_[j + 1]);
       f.push_back(&flows_[j]);
     }
-    SceneFlowParams p;
+    SceneFlowParams p = plain();
     p.gaps = gaps;
     label_stereo_flow_window(disps_[0], d, f, cam_, {}, p, kDt, danger_, ttc_, vel_);
   }
@@ -502,6 +530,92 @@ TEST_F(FarApproach, GapTenNeedsTenFrames) {
   label({10}, 9);
   EXPECT_EQ(cv::countNonZero(danger_), 0);
   EXPECT_TRUE(std::isnan(vel_.at<cv::Vec3f>(75, 100)[0]));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Filters for real matchers: depth-edge margin, vertical band, longest gap
+
+TEST(DepthEdges, HandComputedWindow) {
+  // 15 x 9: a step of 3 px at column 7, one invalid pixel; ramp of 0.4 px a column on row 8.
+  cv::Mat d(9, 15, CV_32F, cv::Scalar(2.0f));
+  d(cv::Rect(7, 0, 8, 8)).setTo(5.0f);
+  d.at<float>(1, 1) = -1.0f;
+  cv::Mat mask;
+  mark_depth_edges(d, 2, 1.0, mask);
+  ASSERT_EQ(mask.type(), CV_8UC1);
+  for (int x = 0; x < 15; ++x) {
+    // Rows 0..5 only see the step: columns 5..8 have both sides within 2 px.
+    const bool near = x >= 5 && x <= 8;
+    EXPECT_EQ(mask.at<uint8_t>(3, x) != 0, near) << x;
+  }
+  EXPECT_EQ(mask.at<uint8_t>(1, 2), 0);  // the invalid neighbour does not count
+  // A step of 3 px is not an edge for step_px = 3.5; margin 0 marks nothing.
+  mark_depth_edges(d, 2, 3.5, mask);
+  EXPECT_EQ(cv::countNonZero(mask), 0);
+  mark_depth_edges(d, 0, 1.0, mask);
+  EXPECT_EQ(cv::countNonZero(mask), 0);
+}
+
+TEST(LabelStereoFlow, EdgeMarginSparesThePatchBorder) {
+  const core::Camera cam = odd_camera();  // f B = 20
+  Maps m = wall(cam);
+  const cv::Rect patch(60, 45, 31, 27);
+  m.prev(patch).setTo(20.0 / 2.0);
+  m.cur(patch).setTo(20.0 / 1.9);
+  SceneFlowParams p = plain();
+  p.edge_margin_px = 4;
+  cv::Mat danger, ttc, vel;
+  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, p, kDt, danger, ttc, vel);
+  const cv::Rect inner(patch.x + 4, patch.y + 4, patch.width - 8, patch.height - 8);
+  EXPECT_EQ(cv::countNonZero(danger(inner)), inner.area());
+  EXPECT_EQ(cv::countNonZero(danger), inner.area());
+  EXPECT_TRUE(std::isnan(vel.at<cv::Vec3f>(patch.y, patch.x)[2]));  // not a candidate
+}
+
+TEST(LabelStereoFlow, SourceNearAPastEdgeIsNotDangerous) {
+  const core::Camera cam = odd_camera();
+  Maps m = wall(cam);
+  const cv::Rect now(60, 45, 31, 27);
+  m.cur(now).setTo(20.0 / 1.9);
+  // Before, the patch was 12 px to the left at 2 m, but the flow says 9 px (as flow does near
+  // edges): the sources of the right part of the patch fall near, then beyond, its past edge.
+  m.prev(now - cv::Point(12, 0)).setTo(20.0 / 2.0);
+  m.flow(now).setTo(cv::Scalar(-9, 0));
+  SceneFlowParams p = plain();
+  p.edge_margin_px = 3;
+  core::Envelope env;
+  env.half_width_m = 3.0;  // the sideways drift must not matter here
+  cv::Mat danger, ttc, vel;
+  label_stereo_flow(m.cur, m.prev, m.flow, cam, env, p, kDt, danger, ttc, vel);
+  // Current interior: x in [63, 88), rows [48, 69). The past patch spans [48, 79); q = x - 9
+  // must lie 3 px inside it: q < 76, so x < 85.
+  EXPECT_EQ(cv::countNonZero(danger), 22 * 21);
+  EXPECT_EQ(danger.at<uint8_t>(58, 84), 255);
+  EXPECT_EQ(danger.at<uint8_t>(58, 85), 0);
+  EXPECT_NEAR(vel.at<cv::Vec3f>(58, 85)[2], -3.0, 1e-3);  // known, only not dangerous
+}
+
+TEST(LabelStereoFlow, EnvelopeBandKeepsGroundPointsOut) {
+  const core::Camera cam = odd_camera();
+  Maps m = wall(cam);
+  // A patch 3.8 m ahead, 0.9 m and more below the axis (down to the image's bottom row), moving
+  // along the rays towards the camera: at contact every point is inside the envelope.
+  const double z_now = 3.8, z_before = 3.9;
+  const int y0 = static_cast<int>(std::ceil(cam.cy + 0.9 * cam.focal_px / z_now));
+  const cv::Rect patch(60, y0, 20, cam.height - y0);
+  m.cur(patch).setTo(20.0 / z_now);
+  m.prev(patch).setTo(20.0 / z_before);
+  SceneFlowParams p = plain();
+  p.min_delta_d_px = 0.0;
+  cv::Mat danger, ttc, vel;
+  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, p, kDt, danger, ttc, vel);
+  EXPECT_EQ(cv::countNonZero(danger), patch.area());
+  // With the band only the rows with Y <= y_bottom = 1 m now: y <= cy + f / z = 110.4.
+  p.use_envelope_band = true;
+  label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, p, kDt, danger, ttc, vel);
+  EXPECT_EQ(cv::countNonZero(danger), patch.width * (110 - y0 + 1));
+  EXPECT_EQ(danger.at<uint8_t>(110, 65), 255);
+  EXPECT_EQ(danger.at<uint8_t>(111, 65), 0);
 }
 
 // ---------------------------------------------------------------------------------------------

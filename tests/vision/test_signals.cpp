@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "sg/core/error.hpp"
+
 #include <cmath>
 
 #include "sg/vision/signals.hpp"
@@ -36,6 +38,34 @@ TEST(ExtractObstacles, RectangleGivesExactBoxAndCount) {
   EXPECT_DOUBLE_EQ(obs[0].distance_m, 5.0);
   EXPECT_FALSE(obs[0].ttc_s.has_value());
   EXPECT_EQ(cv::countNonZero(in.mask), 21 * 17);
+}
+
+TEST(ExtractObstacles, MeanVelocityOverFiniteValues) {
+  Inputs in = blank({101, 77});
+  const cv::Rect r(13, 7, 20, 10);
+  in.mask(r).setTo(255);
+  cv::Mat vel(in.mask.size(), CV_32FC3, cv::Scalar::all(std::nanf("")));
+  // Left half (1, 0, -2), right half (3, 0, -4) except one column with a NaN in Y: skipped.
+  vel(cv::Rect(13, 7, 10, 10)).setTo(cv::Scalar(1, 0, -2));
+  vel(cv::Rect(23, 7, 9, 10)).setTo(cv::Scalar(3, 0, -4));
+  vel(cv::Rect(32, 7, 1, 10)).setTo(cv::Scalar(100, std::nanf(""), 100));
+  core::SignalParams p;
+  p.min_area_px = 50;
+  const auto obs = extract_obstacles(in.mask, in.disp, in.ttc, camera_fb50(), p, vel);
+  ASSERT_EQ(obs.size(), 1u);
+  ASSERT_TRUE(obs[0].velocity.has_value());
+  const cv::Vec3d expected = (cv::Vec3d(1, 0, -2) * 100 + cv::Vec3d(3, 0, -4) * 90) / 190.0;
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR((*obs[0].velocity)[i], expected[i], 1e-9);
+  // No finite value in the blob, or no map: no velocity.
+  Inputs again = blank({101, 77});
+  again.mask(r).setTo(255);
+  cv::Mat unknown(again.mask.size(), CV_32FC3, cv::Scalar::all(std::nanf("")));
+  EXPECT_FALSE(
+      extract_obstacles(again.mask, again.disp, again.ttc, camera_fb50(), p, unknown)[0].velocity);
+  EXPECT_FALSE(extract_obstacles(again.mask, again.disp, again.ttc, camera_fb50(), p)[0].velocity);
+  EXPECT_THROW(extract_obstacles(again.mask, again.disp, again.ttc, camera_fb50(), p,
+                                 cv::Mat(again.mask.size(), CV_32FC2)),
+               core::InputError);
 }
 
 TEST(ExtractObstacles, SmallBlobsAreErasedFromTheMask) {

@@ -9,10 +9,15 @@ namespace sg::io {
 /// Settings of a config file that are not detector parameters.
 struct RunSettings {
   double pace_fps = 0.0;  ///< `fps:` pace the emitter, Hz (0 = as fast as possible)
+  int workers = 1;        ///< `workers:` W, farm workers
+  int tiles = 1;          ///< `tiles:` T, row tiles per task
+  int tokens = 0;         ///< `tokens:` frames in flight (0 = automatic)
+  int threads = 0;        ///< `threads:` task-arena size (0 = all cores)
 };
 
 /// Overwrites the fields of `params` (and `settings`) that the file sets; others keep their value.
-/// Sections: mode, fps, stereo, label, envelope, signal (see README). Throws core::InputError
+/// Sections: mode, fps, stereo, label, envelope, signal, flow, scene_flow (with scene_flow.ground)
+/// (see README and docs/stereo-flow.md). Throws core::InputError
 /// naming the file and the key for a missing file, bad YAML, an unknown key or a wrong type.
 /// Does not validate the values: call core::validate afterwards.
 void apply_config_file(const std::filesystem::path& path, core::DetectorParams& params,

@@ -1,7 +1,8 @@
 #pragma once
-/// The obstacle pipeline: emitter (read, stamp, pace), workers (stereo matching, flow), collector
-/// (labelling, signals), and its metrics. This layer wires the vision kernels onto the skeletons.
-#include <chrono>
+/// The obstacle pipeline (DESIGN 1): emitter (read, stamp, pace, drop), a farm of W workers
+/// (stereo matching and, in Stereo-Flow mode, optical flow, each split into T row tiles),
+/// collector (restore order, label, signals), and its metrics. This layer wires the vision kernels
+/// onto the par skeletons; it is the only place where both meet.
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -17,34 +18,59 @@ namespace sg::pipeline {
 
 struct RunOptions {
   core::DetectorParams params;
-  /// Pace the emitter like a camera at this rate, Hz; 0 = as fast as the pipeline accepts.
+  /// Pace the emitter like a camera at this rate, Hz; 0 = as fast as the pipeline accepts (a
+  /// file: nothing is dropped). When paced, frame n is "captured" at n / pace_fps; a frame whose
+  /// successor was captured before a token was free for it is dropped and counted.
   double pace_fps = 0.0;
+  int workers = 1;   ///< W >= 1: farm tasks (SM, OF) running at once
+  int tiles = 1;     ///< T >= 1: row tiles per task
+  int tokens = 0;    ///< frames in flight; 0 = automatic (W + 1)
+  int threads = 0;   ///< task-arena size; 0 = all cores
+  /// Split the optical-flow task into tiles too. Off by default: DIS works on an image pyramid,
+  /// so tiled flow differs from whole-image flow near the cuts and detections could differ from
+  /// the sequential reference; stereo matching tiles are bit-identical and always used.
+  bool tile_flow = false;
 };
 
 /// Every violation as text; empty when valid (includes core::validate of the detector params).
 std::vector<std::string> validate(const RunOptions& options, const core::Camera& camera);
 
-/// Latency percentiles and throughput of a run (DESIGN 1, "Metrics").
+/// Tokens actually used by `options` (the automatic choice resolved).
+int effective_tokens(const RunOptions& options);
+
+/// The run's metrics (DESIGN 1, "Metrics").
 struct RunSummary {
-  int frames = 0;
+  int frames = 0;               ///< detections produced
+  int dropped = 0;              ///< frames the paced emitter had to skip
   int alarm_frames = 0;
   std::optional<int> first_alarm_frame;
   std::optional<double> first_alarm_time_s;
+  int deadline_misses = 0;      ///< latency > 1 / pace_fps (paced runs only)
   double wall_s = 0.0;          ///< first frame read to last detection, s
   double throughput_fps = 0.0;  ///< frames / wall_s
-  double latency_p50_ms = 0.0, latency_p95_ms = 0.0, latency_p99_ms = 0.0, latency_max_ms = 0.0;
   double service_ms = 0.0;      ///< mean interval between consecutive detections, ms
+  double latency_p50_ms = 0.0, latency_p95_ms = 0.0, latency_p99_ms = 0.0, latency_max_ms = 0.0;
+  double latency_mean_ms = 0.0;
+  /// Busy time per stage summed over the run, ms: emitter (read, convert), stereo matching,
+  /// optical flow, collector (labelling, signals, sinks).
+  double busy_emitter_ms = 0.0, busy_sm_ms = 0.0, busy_of_ms = 0.0, busy_collector_ms = 0.0;
+  /// The configuration that ran.
+  std::string mode;
+  int workers = 1, tiles = 1, tokens = 1, threads = 0;
+  bool tile_flow = false;
+  double pace_fps = 0.0;
 
   nlohmann::json to_json() const;
-  /// A few human lines: frames, alarms, first alarm, fps, latency.
+  /// A few human lines: frames, alarms, first alarm, fps, latency, drops.
   std::string text() const;
 };
 
-/// Called for every detection, in frame order, with its frame.
+/// Called for every detection, in frame order, with its frame (from the collector's thread).
 using DetectionSink = std::function<void(const core::StereoFrame&, const core::Detection&)>;
 
-/// Runs the detector over the whole source (sequentially: W = 1, T = 1). Throws core::InputError
-/// for invalid options or broken input; detections already delivered to `sink` stay delivered.
+/// Runs the detector over the whole source. Throws core::InputError for invalid options or broken
+/// input; an exception anywhere stops the run and is rethrown here; detections already delivered
+/// to `sink` stay delivered. Every (W, T, tokens) gives the same detections as W = T = 1.
 RunSummary run(core::FrameSource& source, const RunOptions& options, const DetectionSink& sink);
 
 }  // namespace sg::pipeline

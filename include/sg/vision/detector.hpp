@@ -15,25 +15,41 @@ namespace sg::vision {
 /// What the workers computed for one frame.
 struct FrameMaps {
   cv::Mat disparity;  ///< CV_32F, px, invalid < 0
-  cv::Mat flow;       ///< CV_32FC2 backward flow (Stereo-Flow mode), empty otherwise
+  /// CV_32FC2 backward flow B_i from L_i to L_{i-1} (Stereo-Flow mode), empty for the first
+  /// frame and in Stereo mode.
+  cv::Mat flow;
 };
 
 class Detector {
  public:
-  /// params must be valid (core::validate). Throws core::InputError for Mode::kStereoFlow (not
-  /// implemented yet).
+  /// params must be valid (core::validate).
   Detector(const core::DetectorParams& params, const core::Camera& camera);
   /// Frames must arrive in order. Labels D_i against the past maps of every configured gap k for
-  /// which k frames of history exist (so the first frame is never dangerous), then obstacles,
-  /// region counts, hysteresis, severity and steering. Fills frame and time_s from `frame`,
-  /// danger = the cleaned mask; leaves latency_ms to the caller. Throws core::InputError when the
-  /// disparity is not a non-empty CV_32F map or changes size within the stream.
+  /// which k frames of history exist (so the first frame is never dangerous): Stereo mode with
+  /// label_stereo (params.stereo), Stereo-Flow mode with label_stereo_flow_window
+  /// (params.scene_flow, dt = camera.frame_period()), whose gap k also needs the flows of the
+  /// last k frames (an empty maps.flow restarts the flow history). Then, in Stereo-Flow mode
+  /// with scene_flow.exclude_ground, dangerous pixels on or below a ground plane fitted to D_i
+  /// are cleared; then obstacles (with the mean 3D velocity in Stereo-Flow mode), region counts,
+  /// hysteresis, severity and steering. Fills frame and time_s from `frame`, danger = the cleaned
+  /// mask; leaves latency_ms to the caller. Throws core::InputError when the disparity is not a
+  /// non-empty CV_32F map, when a non-empty flow is not CV_32FC2 of its size, or when the size
+  /// changes within the stream.
   core::Detection process(const core::StereoFrame& frame, const FrameMaps& maps);
 
  private:
+  /// Stereo-Flow labelling of D_i with maps.flow and the history; fills danger, ttc, velocity.
+  void label_flow(const FrameMaps& maps, cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity);
+
   core::DetectorParams params_;
   core::Camera camera_;
+  int max_gap_ = 1;           ///< longest gap of the active mode
   std::deque<cv::Mat> past_;  ///< past_[0] = D_{i-1}, past_[1] = D_{i-2}, ...
+  /// Stereo-Flow: flows_[0] = B_{i-1}, flows_[1] = B_{i-2}, ... (consecutive, no gap).
+  std::deque<cv::Mat> flows_;
+  /// Stereo-Flow: depth-edge masks (mark_depth_edges) of D_i (edges_) and of past_ (same order).
+  cv::Mat edges_;
+  std::deque<cv::Mat> past_edges_;
   RegionHysteresis hysteresis_;
 };
 

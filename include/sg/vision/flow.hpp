@@ -6,31 +6,16 @@
 #include <string>
 #include <vector>
 
+#include "sg/core/params.hpp"
+
 namespace sg::vision {
 
-enum class FlowMethod { kDisUltrafast, kDisFast, kDisMedium, kFarneback };
-
-/// "dis-ultrafast" / "dis-fast" / "dis-medium" / "farneback".
-const char* to_string(FlowMethod m);
-/// Parses the names of to_string(); throws core::InputError naming the text otherwise.
-FlowMethod parse_flow_method(const std::string& text);
-
-struct FlowParams {
-  FlowMethod method = FlowMethod::kDisUltrafast;
-  /// Rows of context a tile reads above and below its own rows (compute_flow_rows), px. DIS and
-  /// Farneback work on pyramids, so a tile differs from the whole image near its cut anyway.
-  int tile_halo_px = 48;
-  // Farneback only (cv::calcOpticalFlowFarneback); OpenCV's sample values.
-  double fb_pyr_scale = 0.5;  ///< pyramid scale between levels, in (0, 1)
-  int fb_levels = 3;          ///< pyramid levels, >= 1
-  int fb_win_size = 15;       ///< averaging window, px, >= 3
-  int fb_iterations = 3;      ///< iterations per level, >= 1
-  int fb_poly_n = 5;          ///< polynomial expansion neighbourhood, 5 or 7
-  double fb_poly_sigma = 1.2;  ///< Gaussian sigma of the expansion, > 0 (1.1 for n=5, 1.5 for 7)
-};
-
-/// Every violation as "flow.<field>=<value>: <rule>"; empty when valid.
-std::vector<std::string> validate(const FlowParams& p);
+// The flow settings live in core (DetectorParams.flow); these names keep vision code short.
+using core::FlowMethod;
+using core::FlowParams;
+using core::parse_flow_method;
+using core::to_string;
+using core::validate;
 
 /// Backward flow B from `current` to `previous`: the point at pixel p of `current` was at
 /// q = p + B(p) in `previous` (so previous(q) ~ current(p)). Both images CV_8UC1, same size, at

@@ -12,26 +12,10 @@
 
 namespace sg::vision {
 
-struct SceneFlowParams {
-  /// Frame gaps k compared by label_stereo_flow_window: P_i against P_{i-k} along the chained
-  /// flow. k = 1 is the thesis; larger k see slow (far) approaches whose per-frame disparity
-  /// change is below the matcher's noise. Gaps beyond the history given are skipped.
-  std::vector<int> gaps = {1, 4, 10};
-  double v_min_mps = 0.3;  ///< approach speed the point must reach, -V_z >= v_min, m/s
-  double z_max_m = 12.0;   ///< ignore points farther than this, m
-  /// The disparity must have grown by this much over the gap, D_i(p) - D_{i-k}(q) >= this, px:
-  /// a noise gate, as in Stereo mode; 0 disables it.
-  double min_delta_d_px = 0.5;
-  /// Velocities faster than this are mismatches and are ignored, m/s.
-  double max_speed_mps = 40.0;
-  /// The past disparity D_{i-k}(q) is unknown when the neighbours its bilinear sample uses differ
-  /// by more than this, px: at a depth edge the mix of object and background would look like a
-  /// fast approach. Infinity disables the check.
-  double max_disparity_step_px = 1.0;
-};
-
-/// Every violation as "scene_flow.<field>=<value>: <rule>"; empty when valid.
-std::vector<std::string> validate(const SceneFlowParams& p);
+// The labelling settings live in core (DetectorParams.scene_flow).
+using core::GroundParams;
+using core::SceneFlowParams;
+using core::validate;
 
 /// Bilinear sample of a CV_32F disparity map (invalid < 0) at (x, y), px. Neighbours with zero
 /// weight are not used (so integer coordinates read one pixel, and x = w-1 is inside). False when
@@ -57,13 +41,20 @@ bool point_velocity(cv::Point2f p, float d_cur, cv::Point2f q, float d_prev,
 bool heads_into_envelope(const cv::Point3d& P, const cv::Vec3d& V, const core::Envelope& e,
                          double v_min, double& t_contact);
 
+/// 255 where p lies within margin_px of a depth edge: the largest and smallest valid (>= 0)
+/// disparities of the (2 margin + 1)^2 window around p differ by more than step_px; 0 elsewhere
+/// (everywhere when margin_px <= 0). disp: CV_32F, invalid < 0; mask: CV_8U, allocated.
+void mark_depth_edges(const cv::Mat& disp, int margin_px, double step_px, cv::Mat& mask);
+
 /// Gap-1 Stereo-Flow labelling of frame i. disp_cur = D_i, disp_prev = D_{i-1} (CV_32F, invalid
 /// < 0), flow = B_i (CV_32FC2 backward flow i -> i-1), all the same size; dt = frame period, s.
-/// p is dangerous when D_i(p) > 0, q = p + B_i(p) samples D_{i-1}(q) > 0 bilinearly (with
-/// max_disparity_step_px), Z_i <= z_max,
-/// D_i(p) - D_{i-1}(q) >= min_delta_d_px, |V| <= max_speed and heads_into_envelope. p.gaps is not
-/// used. Outputs (allocated): danger CV_8U 0/255; ttc CV_32F s, NaN where safe; velocity
-/// CV_32FC3 m/s, NaN where it cannot be computed (it is filled beyond z_max too).
+/// A pixel p is a candidate when D_i(p) > 0, Z_i <= z_max, p is not within edge_margin_px of a
+/// depth edge of D_i (mark_depth_edges) and, with use_envelope_band, y_top <= Y_i <= y_bottom.
+/// A candidate's velocity is known when q = p + B_i(p) samples D_{i-1}(q) > 0 bilinearly (with
+/// max_disparity_step_px); it is dangerous when moreover D_i(p) - D_{i-1}(q) >= min_delta_d_px,
+/// |V| <= max_speed, round(q) is not within edge_margin_px of a depth edge of D_{i-1}, and
+/// heads_into_envelope. p.gaps is not used. Outputs (allocated): danger CV_8U 0/255; ttc CV_32F
+/// s, NaN where safe; velocity CV_32FC3 m/s, NaN where unknown or not a candidate.
 void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const cv::Mat& flow,
                        const core::Camera& cam, const core::Envelope& env,
                        const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
@@ -73,14 +64,19 @@ void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const 
 /// past_flows[j] = B_{i-j} (newest first: past_flows[0] is the current frame's flow). For gap k
 /// the point is followed back along the chained flow q_0 = p, q_{m+1} = q_m + B_{i-m}(q_m)
 /// (bilinear) to q_k, and V = (P_i(p) - P_{i-k}(q_k, D_{i-k}(q_k))) / (k dt); the test is that of
-/// label_stereo_flow. A gap needs k past disparities and k flows; longer gaps are skipped. A pixel
-/// flagged by any gap is dangerous; its TTC is the smallest over the flagging gaps and its velocity
-/// that of the gap giving it; a safe pixel's velocity comes from the largest gap that gives one.
+/// label_stereo_flow. A gap needs k past disparities and k flows; longer gaps are skipped. With
+/// p.longest_gap_decides the longest gap that knows the pixel's velocity gives its verdict, TTC
+/// and velocity. Otherwise a pixel flagged by any gap is dangerous; its TTC is the smallest over
+/// the flagging gaps and its velocity that of the gap giving it; a safe pixel's velocity comes
+/// from the largest gap that gives one. edges_cur / edges_past (optional): mark_depth_edges of
+/// D_i / of past_disps (same order, same margin and step), when the caller keeps them from frame to
+/// frame; computed here (at q only, for the past) when null.
 void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const cv::Mat*>& past_disps,
                               const std::vector<const cv::Mat*>& past_flows,
                               const core::Camera& cam, const core::Envelope& env,
                               const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
-                              cv::Mat& velocity);
+                              cv::Mat& velocity, const cv::Mat* edges_cur = nullptr,
+                              const std::vector<const cv::Mat*>* edges_past = nullptr);
 
 /// A plane n . P + c = 0 in camera coordinates (|n| = 1, n pointing up, i.e. n_y < 0).
 struct GroundPlane {
@@ -88,16 +84,6 @@ struct GroundPlane {
   double offset = 0.0;  ///< c, m
   int inliers = 0;      ///< sample points within the tolerance
   bool found = false;
-};
-
-struct GroundParams {
-  double lower_fraction = 0.4;  ///< fit on the bottom fraction of the image rows, (0, 1]
-  int sample_step_px = 4;       ///< sample every n-th row and column, >= 1
-  int iterations = 200;         ///< RANSAC iterations, >= 1
-  double tolerance_m = 0.05;    ///< inlier distance to the plane, m
-  double z_max_m = 12.0;        ///< ignore points farther than this, m
-  int min_inliers = 200;        ///< fewer inliers: no plane found
-  std::uint64_t seed = 12345;   ///< fixed RANSAC seed (reproducible)
 };
 
 /// Fits the ground plane to the valid 3D points of the lower image by RANSAC (3-point samples,

@@ -16,10 +16,13 @@ namespace sg::vision {
 /// raster order of their first pixel: bbox, pixels, median depth (m) of the blob's pixels with
 /// disparity > 0 (0 when none), median TTC (s) of finite ttc values (empty when none); medians of
 /// an even count average the two middle values. mask: CV_8U 0/255; disp: CV_32F (invalid < 0);
-/// ttc: CV_32F (NaN = none); all the same size.
+/// ttc: CV_32F (NaN = none); all the same size. When `velocity` (CV_32FC3, m/s, NaN = unknown,
+/// the size of the mask) is given, each obstacle's velocity is the mean over its pixels whose
+/// three components are finite (left empty when none).
 std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp,
                                               const cv::Mat& ttc, const core::Camera& camera,
-                                              const core::SignalParams& p);
+                                              const core::SignalParams& p,
+                                              const cv::Mat& velocity = cv::Mat());
 
 /// Names of `columns` regions: {"left", "centre", "right"} for 3, else "r0", "r1", ...
 std::vector<std::string> region_names(int columns);

@@ -1,0 +1,58 @@
+#pragma once
+/// Throughput and latency sweeps (the `bench` command): modes x W x T at chosen resolutions, on
+/// frames rendered once and held in memory, beside the baseline a user would write (a plain
+/// sequential OpenCV loop) measured in the same run.
+#include <functional>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "sg/core/params.hpp"
+
+namespace sg::pipeline {
+
+struct BenchConfig {
+  std::vector<core::Mode> modes = {core::Mode::kStereo, core::Mode::kStereoFlow};
+  std::vector<int> workers = {1, 2, 3};
+  std::vector<int> tiles = {1, 2, 4};
+  std::vector<cv::Size> resolutions = {{640, 480}, {1242, 375}};
+  int frames = 300;          ///< frames per configuration
+  int num_disparities = 64;  ///< stereo search range, px
+  int threads = 0;           ///< task-arena size (0 = all cores)
+  std::string scenario = "head-on";
+  /// Also run the best configuration of each mode (first resolution) paced at these fractions of
+  /// its measured capacity (empty = none).
+  std::vector<double> pace_fractions = {0.8, 1.5};
+};
+
+std::vector<std::string> validate(const BenchConfig& config);
+
+struct BenchRow {
+  /// "baseline" (plain loop, OpenCV on one thread: the reference), "opencv-mt" (the same loop
+  /// with OpenCV's own parallel loops), "pipeline" or "paced"
+  std::string kind;
+  std::string mode;        ///< "stereo" / "stereo-flow"
+  cv::Size resolution;
+  int workers = 0, tiles = 0, tokens = 0;
+  double pace_fps = 0.0;   ///< paced runs: the camera rate, Hz
+  int frames = 0, dropped = 0, deadline_misses = 0;
+  double fps = 0.0;        ///< throughput, frames / s
+  double speedup = 0.0;    ///< fps / baseline fps of the same mode and resolution
+  double latency_p50_ms = 0.0, latency_p99_ms = 0.0, service_ms = 0.0;
+  /// Per-frame signals equal to the baseline's (pipeline rows) / to the unpaced run's (paced rows:
+  /// only comparable when nothing was dropped).
+  bool same_detections = true;
+};
+
+/// "kind,mode,width,height,workers,tiles,tokens,pace_fps,frames,dropped,deadline_misses,fps,
+/// speedup,latency_p50_ms,latency_p99_ms,service_ms,same_detections"
+std::string bench_csv_header();
+/// "yes" / "no", or "n/a" for a paced run that dropped frames.
+std::string same_detections_text(const BenchRow& row);
+std::string to_csv(const BenchRow& row);
+
+/// Runs the sweep; `on_row` sees each row as soon as it is measured.
+std::vector<BenchRow> run_bench(const BenchConfig& config,
+                                const std::function<void(const BenchRow&)>& on_row);
+
+}  // namespace sg::pipeline

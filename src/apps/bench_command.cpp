@@ -1,0 +1,132 @@
+// `stereoguard bench`: throughput and latency of the pipeline configurations beside a plain
+// sequential OpenCV loop measured in the same run.
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+
+#include "commands.hpp"
+#include "sg/core/error.hpp"
+#include "sg/pipeline/bench.hpp"
+
+namespace sg::apps {
+namespace {
+
+struct BenchArgs {
+  std::vector<std::string> modes = {"stereo", "stereo-flow"};
+  std::vector<int> workers = {1, 2, 3};
+  std::vector<int> tiles = {1, 2, 4};
+  std::vector<std::string> resolutions = {"640x480", "1242x375"};
+  std::vector<double> pace = {0.8, 1.5};
+  int frames = 300;
+  int num_disparities = 64;
+  int threads = 0;
+  std::string scenario = "head-on";
+  std::string csv = "stereoguard-bench.csv";
+  std::string plot;
+};
+
+cv::Size parse_resolution(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x') {
+    throw core::InputError("resolution=" + text + ": must look like 640x480");
+  }
+  return {w, h};
+}
+
+void print_row(const pipeline::BenchRow& r) {
+  std::cout << std::left << std::setw(9) << r.kind << std::setw(12) << r.mode << std::right
+            << std::setw(5) << r.resolution.width << "x" << std::left << std::setw(5)
+            << r.resolution.height << std::right << std::setw(3) << r.workers << std::setw(4)
+            << r.tiles << std::setw(4) << r.tokens << std::fixed << std::setprecision(1)
+            << std::setw(8) << r.pace_fps << std::setw(8) << r.fps << std::setprecision(2)
+            << std::setw(8) << r.speedup << std::setprecision(1) << std::setw(8)
+            << r.latency_p50_ms << std::setw(8) << r.latency_p99_ms << std::setw(7) << r.dropped
+            << "  " << pipeline::same_detections_text(r) << std::endl;
+}
+
+void write_plot(const std::string& csv, const std::string& png) {
+  const std::string script = png + ".gnuplot";
+  {
+    std::ofstream g(script);
+    g << "set datafile separator ','\n"
+      << "set terminal pngcairo size 1100,700 noenhanced\n"
+      << "set output '" << png << "'\n"
+      << "set multiplot layout 2,1 title 'stereoguard bench (" << csv << ")'\n"
+      << "set style data histograms\nset style fill solid 0.8\nset xtics rotate by -45 font ',8'\n"
+      << "set ylabel 'throughput (fps)'\n"
+      << "plot '" << csv << "' every ::1 using 12:xtic(stringcolumn(1).' '.stringcolumn(2)."
+         "' '.stringcolumn(3).' W'.stringcolumn(5).' T'.stringcolumn(6)) title 'fps'\n"
+      << "set ylabel 'latency (ms)'\n"
+      << "plot '" << csv << "' every ::1 using 14:xtic(stringcolumn(1).' '.stringcolumn(2)."
+         "' '.stringcolumn(3).' W'.stringcolumn(5).' T'.stringcolumn(6)) title 'p50', "
+         "'' every ::1 using 15 title 'p99'\n"
+      << "unset multiplot\n";
+  }
+  const std::string cmd = "gnuplot '" + script + "'";
+  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    throw core::InputError("--plot needs gnuplot (apt-get install gnuplot-nox); the CSV is " + csv);
+  }
+  if (std::system(cmd.c_str()) != 0) throw core::InputError("gnuplot failed on " + script);
+  std::remove(script.c_str());
+}
+
+void bench_main(const BenchArgs& a) {
+  pipeline::BenchConfig config;
+  config.modes.clear();
+  for (const auto& m : a.modes) config.modes.push_back(core::parse_mode(m));
+  config.workers = a.workers;
+  config.tiles = a.tiles;
+  config.resolutions.clear();
+  for (const auto& r : a.resolutions) config.resolutions.push_back(parse_resolution(r));
+  config.frames = a.frames;
+  config.num_disparities = a.num_disparities;
+  config.threads = a.threads;
+  config.scenario = a.scenario;
+  config.pace_fractions = a.pace;
+  core::throw_if_invalid(pipeline::validate(config), "invalid bench settings");
+
+  std::ofstream csv(a.csv);
+  if (!csv) throw core::InputError("cannot write " + a.csv);
+  csv << pipeline::bench_csv_header() << "\n";
+  std::cout << "stereoguard bench: scenario " << a.scenario << ", " << a.frames
+            << " frames per configuration, rendered once and held in memory\n"
+            << "kind     mode          resolution  W   T tok  pace/s     fps speedup"
+               "     p50     p99   drop  same\n";
+  pipeline::run_bench(config, [&](const pipeline::BenchRow& row) {
+    print_row(row);
+    csv << pipeline::to_csv(row) << "\n" << std::flush;
+  });
+  std::cout << "csv: " << a.csv << "\n";
+  if (!a.plot.empty()) {
+    csv.close();
+    write_plot(a.csv, a.plot);
+    std::cout << "plot: " << a.plot << "\n";
+  }
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app) {
+  auto a = std::make_shared<BenchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "throughput/latency sweep of modes x W x T against a plain OpenCV loop");
+  cmd->add_option("--modes", a->modes, "modes, comma-separated")->delimiter(',');
+  cmd->add_option("--workers", a->workers, "W values, comma-separated")->delimiter(',');
+  cmd->add_option("--tiles", a->tiles, "T values, comma-separated")->delimiter(',');
+  cmd->add_option("--resolutions", a->resolutions, "e.g. 640x480,1242x375")->delimiter(',');
+  cmd->add_option("--frames", a->frames, "frames per configuration (default 300)");
+  cmd->add_option("--num-disparities", a->num_disparities, "stereo search range (default 64)");
+  cmd->add_option("--threads", a->threads, "task-arena size (default 0 = all cores)");
+  cmd->add_option("--scenario", a->scenario, "scenario rendered for the frames (default head-on)");
+  cmd->add_option("--pace", a->pace,
+                  "also pace the best configuration at these fractions of its capacity "
+                  "(first resolution; default 0.8,1.5)")
+      ->delimiter(',');
+  cmd->add_option("--csv", a->csv, "CSV output (default stereoguard-bench.csv)");
+  cmd->add_option("--plot", a->plot, "draw throughput and latency to this PNG (needs gnuplot)");
+  cmd->callback([a] { bench_main(*a); });
+}
+
+}  // namespace sg::apps

@@ -1,0 +1,232 @@
+#include "sg/pipeline/bench.hpp"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <sstream>
+
+#include "sg/core/error.hpp"
+#include "sg/io/memory_source.hpp"
+#include "sg/par/metrics.hpp"
+#include "sg/pipeline/runner.hpp"
+#include "sg/sim/renderer.hpp"
+#include "sg/vision/detector.hpp"
+
+namespace sg::pipeline {
+namespace {
+
+/// The scenario at another resolution (same focal length, centred principal point).
+sim::Scenario scaled(sim::Scenario s, cv::Size size, int frames) {
+  s.camera.width = size.width;
+  s.camera.height = size.height;
+  s.camera.cx = (size.width - 1) / 2.0;
+  s.camera.cy = (size.height - 1) / 2.0;
+  s.frames = frames;
+  return s;
+}
+
+/// Renders `frames` frames; scenarios shorter than that are played forwards then backwards.
+std::vector<core::StereoFrame> render(const sim::Scenario& scenario, int frames) {
+  const sim::Renderer renderer(scenario);
+  std::vector<core::StereoFrame> out;
+  out.reserve(frames);
+  for (int i = 0; i < frames; ++i) {
+    const int period = 2 * scenario.frames - 2;
+    const int k = i % period;
+    core::StereoFrame f = renderer.render(k < scenario.frames ? k : period - k).frame;
+    f.index = i;
+    f.time_s = i / scenario.camera.fps;
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
+struct Measured {
+  BenchRow row;
+  std::vector<bool> signals;
+};
+
+/// Sets OpenCV's thread count for the lifetime of the object.
+class OpenCvThreads {
+ public:
+  explicit OpenCvThreads(int n) : saved_(cv::getNumThreads()) { cv::setNumThreads(n); }
+  ~OpenCvThreads() { cv::setNumThreads(saved_); }
+  OpenCvThreads(const OpenCvThreads&) = delete;
+  OpenCvThreads& operator=(const OpenCvThreads&) = delete;
+
+ private:
+  int saved_;
+};
+
+/// The loop a user would write with OpenCV: StereoBM, DIS, our labelling, one frame at a time.
+/// `opencv_threads` = 1 makes it truly sequential (the reference of DESIGN 8); -1 leaves OpenCV's
+/// own parallel loops on (StereoBM splits each frame into stripes on all cores).
+Measured run_baseline(const std::vector<core::StereoFrame>& frames, const core::Camera& camera,
+                      const core::DetectorParams& params, int opencv_threads) {
+  const OpenCvThreads threads(opencv_threads);
+  cv::Ptr<cv::StereoBM> bm = cv::StereoBM::create(params.bm.num_disparities, params.bm.block_size);
+  bm->setPreFilterCap(params.bm.prefilter_cap);
+  bm->setTextureThreshold(params.bm.texture_threshold);
+  bm->setUniquenessRatio(params.bm.uniqueness_ratio);
+  bm->setSpeckleWindowSize(params.bm.speckle_window);
+  bm->setSpeckleRange(params.bm.speckle_range * 16);
+  bm->setDisp12MaxDiff(params.bm.lr_max_diff);
+  cv::Ptr<cv::DISOpticalFlow> dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_ULTRAFAST);
+  vision::Detector detector(params, camera);
+
+  Measured m;
+  par::LatencyStats latency;
+  cv::Mat disp16;
+  const par::TimePoint start = par::now();
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const par::TimePoint t0 = par::now();
+    vision::FrameMaps maps;
+    bm->compute(frames[i].left, frames[i].right, disp16);
+    disp16.convertTo(maps.disparity, CV_32F, 1.0 / 16);
+    if (params.mode == core::Mode::kStereoFlow && i > 0) {
+      dis->calc(frames[i].left, frames[i - 1].left, maps.flow);
+    }
+    m.signals.push_back(detector.process(frames[i], maps).signal);
+    latency.add(par::elapsed_ms(t0));
+  }
+  const double wall_s = par::elapsed_ms(start) / 1000.0;
+  m.row.kind = opencv_threads == 1 ? "baseline" : "opencv-mt";
+  m.row.frames = static_cast<int>(frames.size());
+  m.row.fps = m.row.frames / wall_s;
+  m.row.latency_p50_ms = latency.p50();
+  m.row.latency_p99_ms = latency.p99();
+  m.row.service_ms = latency.mean();
+  m.row.workers = m.row.tiles = m.row.tokens = 1;
+  return m;
+}
+
+Measured run_pipeline(const std::vector<core::StereoFrame>& frames, const core::Camera& camera,
+                      const RunOptions& options) {
+  io::MemorySource source(frames, camera);
+  Measured m;
+  const RunSummary s = run(source, options, [&m](const core::StereoFrame&,
+                                                 const core::Detection& d) {
+    m.signals.push_back(d.signal);
+  });
+  m.row.kind = options.pace_fps > 0 ? "paced" : "pipeline";
+  m.row.workers = options.workers;
+  m.row.tiles = options.tiles;
+  m.row.tokens = s.tokens;
+  m.row.pace_fps = options.pace_fps;
+  m.row.frames = s.frames;
+  m.row.dropped = s.dropped;
+  m.row.deadline_misses = s.deadline_misses;
+  m.row.fps = s.throughput_fps;
+  m.row.latency_p50_ms = s.latency_p50_ms;
+  m.row.latency_p99_ms = s.latency_p99_ms;
+  m.row.service_ms = s.service_ms;
+  return m;
+}
+
+}  // namespace
+
+std::vector<std::string> validate(const BenchConfig& c) {
+  std::vector<std::string> out;
+  if (c.modes.empty()) out.push_back("bench.modes: at least one mode");
+  if (c.workers.empty()) out.push_back("bench.workers: at least one value");
+  for (int w : c.workers)
+    if (w < 1 || w > 64) out.push_back("bench.workers=" + std::to_string(w) + ": must be in 1..64");
+  if (c.tiles.empty()) out.push_back("bench.tiles: at least one value");
+  for (int t : c.tiles)
+    if (t < 1 || t > 64) out.push_back("bench.tiles=" + std::to_string(t) + ": must be in 1..64");
+  if (c.resolutions.empty()) out.push_back("bench.resolutions: at least one");
+  for (const cv::Size& s : c.resolutions)
+    if (s.width < 64 || s.height < 64 || s.width > 4096 || s.height > 4096)
+      out.push_back("bench.resolution=" + std::to_string(s.width) + "x" +
+                    std::to_string(s.height) + ": each side must be in 64..4096");
+  if (c.frames < 10) out.push_back("bench.frames=" + std::to_string(c.frames) + ": must be >= 10");
+  for (double f : c.pace_fractions)
+    if (!(f > 0 && f <= 10)) out.push_back("bench.pace: fractions must be in (0, 10]");
+  return out;
+}
+
+std::string same_detections_text(const BenchRow& r) {
+  if (r.kind == "paced" && r.dropped > 0) return "n/a";
+  return r.same_detections ? "yes" : "no";
+}
+
+std::string bench_csv_header() {
+  return "kind,mode,width,height,workers,tiles,tokens,pace_fps,frames,dropped,deadline_misses,fps,"
+         "speedup,latency_p50_ms,latency_p99_ms,service_ms,same_detections";
+}
+
+std::string to_csv(const BenchRow& r) {
+  std::ostringstream s;
+  s << r.kind << "," << r.mode << "," << r.resolution.width << "," << r.resolution.height << ","
+    << r.workers << "," << r.tiles << "," << r.tokens << "," << r.pace_fps << "," << r.frames
+    << "," << r.dropped << "," << r.deadline_misses << "," << r.fps << "," << r.speedup << ","
+    << r.latency_p50_ms << "," << r.latency_p99_ms << "," << r.service_ms << ","
+    << same_detections_text(r);
+  return s.str();
+}
+
+std::vector<BenchRow> run_bench(const BenchConfig& config,
+                                const std::function<void(const BenchRow&)>& on_row) {
+  core::throw_if_invalid(validate(config), "invalid bench settings");
+  const sim::Scenario base = sim::resolve_scenario(config.scenario);
+  std::vector<BenchRow> rows;
+  auto emit = [&](BenchRow row) {
+    on_row(row);
+    rows.push_back(std::move(row));
+  };
+
+  for (size_t r = 0; r < config.resolutions.size(); ++r) {
+    const cv::Size size = config.resolutions[r];
+    const sim::Scenario scenario = scaled(base, size, base.frames);
+    const std::vector<core::StereoFrame> frames = render(scenario, config.frames);
+    for (core::Mode mode : config.modes) {
+      RunOptions options;
+      options.params.mode = mode;
+      options.params.bm.num_disparities = config.num_disparities;
+      options.threads = config.threads;
+      core::throw_if_invalid(validate(options, scenario.camera), "invalid bench settings");
+
+      Measured baseline = run_baseline(frames, scenario.camera, options.params, 1);
+      baseline.row.mode = core::to_string(mode);
+      baseline.row.resolution = size;
+      baseline.row.speedup = 1.0;
+      emit(baseline.row);
+      Measured opencv_mt = run_baseline(frames, scenario.camera, options.params, -1);
+      opencv_mt.row.mode = baseline.row.mode;
+      opencv_mt.row.resolution = size;
+      opencv_mt.row.speedup = opencv_mt.row.fps / baseline.row.fps;
+      opencv_mt.row.same_detections = opencv_mt.signals == baseline.signals;
+      emit(opencv_mt.row);
+
+      Measured best;
+      for (int w : config.workers) {
+        for (int t : config.tiles) {
+          options.workers = w;
+          options.tiles = t;
+          Measured m = run_pipeline(frames, scenario.camera, options);
+          m.row.mode = core::to_string(mode);
+          m.row.resolution = size;
+          m.row.speedup = m.row.fps / baseline.row.fps;
+          m.row.same_detections = m.signals == baseline.signals;
+          if (m.row.fps > best.row.fps) best = m;
+          emit(m.row);
+        }
+      }
+      if (r != 0) continue;
+      for (double fraction : config.pace_fractions) {
+        options.workers = best.row.workers;
+        options.tiles = best.row.tiles;
+        options.pace_fps = fraction * best.row.fps;
+        Measured m = run_pipeline(frames, scenario.camera, options);
+        options.pace_fps = 0;
+        m.row.mode = core::to_string(mode);
+        m.row.resolution = size;
+        m.row.speedup = m.row.fps / baseline.row.fps;
+        m.row.same_detections = m.row.dropped == 0 ? m.signals == baseline.signals : false;
+        emit(m.row);
+      }
+    }
+  }
+  return rows;
+}
+
+}  // namespace sg::pipeline

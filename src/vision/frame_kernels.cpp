@@ -1,0 +1,38 @@
+#include "sg/vision/frame_kernels.hpp"
+
+#include <string>
+
+#include "sg/core/error.hpp"
+#include "sg/vision/flow.hpp"
+#include "sg/vision/stereo_bm.hpp"
+
+namespace sg::vision {
+
+void check_frame(const core::StereoFrame& frame) {
+  if (frame.left.empty() || frame.left.type() != CV_8UC1 || frame.right.type() != CV_8UC1 ||
+      frame.left.size() != frame.right.size()) {
+    throw core::InputError("frame " + std::to_string(frame.index) +
+                           ": left and right must be 8-bit gray images of the same size");
+  }
+}
+
+void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& params,
+                    cv::Mat& disp, cv::Range rows) {
+  match_bm_rows(frame.left, frame.right, params.bm, disp, rows);
+}
+
+void disparity_finish(const core::DetectorParams& params, cv::Mat& disp) {
+  filter_speckles(disp, params.bm);
+}
+
+void flow_rows(const cv::Mat& current, const cv::Mat& previous,
+               const core::DetectorParams& params, cv::Mat& flow, cv::Range rows) {
+  compute_flow_rows(current, previous, params.flow, flow, rows);
+}
+
+void allocate_maps(cv::Size size, bool with_flow, cv::Mat& disp, cv::Mat& flow) {
+  disp.create(size, CV_32F);
+  if (with_flow) flow.create(size, CV_32FC2);
+}
+
+}  // namespace sg::vision
