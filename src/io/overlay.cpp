@@ -1,6 +1,7 @@
 #include "sg/io/overlay.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -69,7 +70,9 @@ void draw_obstacles(cv::Mat& out, const std::vector<core::Obstacle>& obstacles, 
     }
     lines.emplace_back(text);
     if (o.velocity) {
-      const cv::Vec3d& v = *o.velocity;
+      cv::Vec3d v = *o.velocity;
+      for (int i = 0; i < 3; ++i)
+        if (std::abs(v[i]) < 0.05) v[i] = 0.0;  // no "-0.0"
       std::snprintf(text, sizeof text, "v %.1f,%.1f,%.1f m/s", v[0], v[1], v[2]);
       lines.emplace_back(text);
     }
