@@ -1,10 +1,10 @@
 #include "sg/par/backend.hpp"
 
+#include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/task_arena.h>
 
 namespace sg::par {
-
 
 const char* to_string(Backend backend) {
   switch (backend) {
@@ -31,6 +31,12 @@ void run_in_arena(int threads, const std::function<void()>& body) {
   if (threads <= 0) {
     body();
     return;
+  }
+  // An arena larger than the machine (e.g. one extra thread for a stage that mostly sleeps) needs
+  // the process-wide limit raised while it runs; TBB otherwise caps its workers at the cores.
+  std::optional<tbb::global_control> allow;
+  if (threads > default_threads()) {
+    allow.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
   }
   tbb::task_arena arena(threads);
   arena.execute(body);  // runs `body` on this thread, joined to the arena

@@ -166,6 +166,11 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   farm.workers = options.workers;
   farm.tokens = s.tokens;
   farm.threads = options.threads;
+  if (options.pace_fps > 0 && farm.backend == par::Backend::kTbb) {
+    // The paced emitter sleeps between frames on one of the arena's threads: give the arena one
+    // more thread so that sleeping does not take a core away from the workers.
+    farm.threads = (options.threads > 0 ? options.threads : par::default_threads()) + 1;
+  }
 
   Emitter emitter(source, options.pace_fps);
   par::LatencyStats latency;
@@ -199,11 +204,18 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   };
 
   try {
-    par::run_in_arena(options.threads, [&] {
+    auto run_farm = [&] {
       par::run_ordered_farm_tasks(
           farm, [&] { return emitter(); },
           [&](FrameJob& job) { return make_tasks(job, options); }, collect);
-    });
+    };
+    // The TBB farm runs in its own arena of `threads`; the sequential one gets an arena here so
+    // that OpenCV's own parallel loops respect `threads` too.
+    if (farm.backend == par::Backend::kSequential) {
+      par::run_in_arena(options.threads, run_farm);
+    } else {
+      run_farm();
+    }
   } catch (const cv::Exception& e) {
     // OpenCV rejects what our validation let through only for broken input.
     throw core::InputError(std::string("processing failed: ") + e.what());

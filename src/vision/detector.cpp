@@ -54,6 +54,17 @@ core::Detection Detector::process(const core::StereoFrame& frame, const FrameMap
       (maps.flow.type() != CV_32FC2 || maps.flow.size() != disp.size()))
     throw core::InputError("detector: the flow must be a CV_32FC2 map of the disparity's size");
 
+  if (!past_index_.empty() && frame.index <= past_index_.front())
+    throw core::InputError("detector: frames must arrive in increasing index order");
+  // Stereo-Flow chains the flows of consecutive frames; after a dropped frame the chain (and the
+  // past it refers to) starts afresh. Stereo mode measures each gap by frame indices instead.
+  if (flow_mode && !past_index_.empty() && frame.index != past_index_.front() + 1) {
+    past_.clear();
+    past_index_.clear();
+    past_edges_.clear();
+    flows_.clear();
+  }
+
   core::Detection det;
   det.frame = frame.index;
   det.time_s = frame.time_s;
@@ -64,7 +75,8 @@ core::Detection Detector::process(const core::StereoFrame& frame, const FrameMap
     std::vector<PastDisparity> past;
     for (int k : params_.stereo.gaps)
       if (k <= static_cast<int>(past_.size()))
-        past.push_back({k, &past_[static_cast<size_t>(k - 1)]});
+        past.push_back({frame.index - past_index_[static_cast<size_t>(k - 1)],
+                        &past_[static_cast<size_t>(k - 1)]});
     label_stereo(disp, past, camera_, params_.stereo, params_.envelope, det.danger, ttc);
   }
   det.obstacles = extract_obstacles(det.danger, disp, ttc, camera_, params_.signal, velocity);
@@ -75,7 +87,11 @@ core::Detection Detector::process(const core::StereoFrame& frame, const FrameMap
   det.steering = steering_hint(det.regions);
 
   past_.push_front(disp.clone());
-  while (static_cast<int>(past_.size()) > max_gap_) past_.pop_back();
+  past_index_.push_front(frame.index);
+  while (static_cast<int>(past_.size()) > max_gap_) {
+    past_.pop_back();
+    past_index_.pop_back();
+  }
   if (flow_mode) {
     past_edges_.push_front(edges_.clone());
     while (static_cast<int>(past_edges_.size()) > max_gap_) past_edges_.pop_back();

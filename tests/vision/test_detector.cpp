@@ -130,6 +130,29 @@ TEST(Detector, GapUsesTheFrameExactlyKFramesAgo) {
   EXPECT_NEAR(*out[3].obstacles[0].ttc_s, 0.9 * (z - 0.5) / z, 1e-6);
 }
 
+TEST(Detector, DroppedFramesStretchTheGapByTheirTime) {
+  // A paced run that dropped frames 1 and 2: the detector sees frames 0 and 3. Gap 1 then spans
+  // three frame periods, so the TTC must equal the one against frame 0 in the test above.
+  core::DetectorParams params;
+  params.stereo.gaps = {1};
+  params.signal.on_k = 1;
+  params.signal.on_n = 1;
+  Detector det(params, camera());
+  const core::Camera cam = camera();
+  core::Detection last;
+  for (int i : {0, 3}) {
+    cv::Mat d(cam.height, cam.width, CV_32F, cv::Scalar(-1.0f));
+    d(kPatch).setTo(9.0f + i);
+    last = det.process(frame(i), {d, {}});
+  }
+  ASSERT_TRUE(last.signal);
+  ASSERT_EQ(last.obstacles.size(), 1u);
+  const double z = 50.0 / 12.0;
+  EXPECT_NEAR(*last.obstacles[0].ttc_s, 0.9 * (z - 0.5) / z, 1e-6);
+  cv::Mat d(cam.height, cam.width, CV_32F, cv::Scalar(-1.0f));
+  EXPECT_THROW(det.process(frame(3), {d, {}}), core::InputError);  // not increasing
+}
+
 // ---------------------------------------------------------------------------------------------
 // Stereo-Flow mode
 

@@ -45,6 +45,9 @@ class Detector {
   core::Camera camera_;
   int max_gap_ = 1;           ///< longest gap of the active mode
   std::deque<cv::Mat> past_;  ///< past_[0] = D_{i-1}, past_[1] = D_{i-2}, ...
+  /// Frame index of each past_ map. Frame indices count camera frames, dropped ones included, so
+  /// a paced run that dropped frames still gets the right time span for each gap.
+  std::deque<int> past_index_;
   /// Stereo-Flow: flows_[0] = B_{i-1}, flows_[1] = B_{i-2}, ... (consecutive, no gap).
   std::deque<cv::Mat> flows_;
   /// Stereo-Flow: depth-edge masks (mark_depth_edges) of D_i (edges_) and of past_ (same order).

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Scores both modes on every built-in scenario and prints a markdown table (README figures).
+# Usage: scripts/eval_all.sh [path/to/stereoguard]
+set -euo pipefail
+bin="${1:-$(dirname "$0")/../build/release/stereoguard}"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+echo "| scenario | mode | GT alarm frames | alarm frames (true) | recall_settled | false_alarm_rate | lead time |"
+echo "|---|---|---:|---:|---:|---:|---|"
+for scenario in $("$bin" scenarios | awk '{print $1}'); do
+  for mode in stereo stereo-flow; do
+    "$bin" eval --scenario "$scenario" --mode "$mode" --json "$tmp/e.json" >/dev/null
+    python3 - "$tmp/e.json" "$scenario" "$mode" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+leads = [l["lead_time_s"] for l in r["lead_times_s"]]
+lead = ", ".join("never" if t is None else f"{t:.2f} s" for t in leads) or "-"
+print(f"| {sys.argv[2]} | {sys.argv[3]} | {r['gt_alarm_frames']} | {r['alarm_frames']} "
+      f"({r['true_alarm_frames']}) | {r['recall_settled']:.3f} | {r['false_alarm_rate']:.3f} | {lead} |")
+PY
+  done
+done
