@@ -166,11 +166,6 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   farm.workers = options.workers;
   farm.tokens = s.tokens;
   farm.threads = options.threads;
-  if (options.pace_fps > 0 && farm.backend == par::Backend::kTbb) {
-    // The paced emitter sleeps between frames on one of the arena's threads: give the arena one
-    // more thread so that sleeping does not take a core away from the workers.
-    farm.threads = (options.threads > 0 ? options.threads : par::default_threads()) + 1;
-  }
 
   Emitter emitter(source, options.pace_fps);
   par::LatencyStats latency;
