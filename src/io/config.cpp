@@ -99,6 +99,7 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("gaps", p.stereo.gaps)
         .field("z_max_m", p.stereo.z_max_m)
         .field("min_delta_d_px", p.stereo.min_delta_d_px)
+        .field("max_growth", p.stereo.max_growth)
         .field("use_envelope_band", p.stereo.use_envelope_band)
         .done();
     Section(root["envelope"], "envelope")
