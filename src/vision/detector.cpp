@@ -6,7 +6,6 @@
 #include "sg/core/error.hpp"
 #include "sg/vision/labelling.hpp"
 #include "sg/vision/scene_flow.hpp"
-#include "sg/vision/stereo_bm.hpp"
 
 namespace sg::vision {
 
@@ -103,15 +102,6 @@ core::Detection Detector::process(const core::StereoFrame& frame, const FrameMap
     while (static_cast<int>(flows_.size()) > max_gap_ - 1) flows_.pop_back();
   }
   return det;
-}
-
-void compute_disparity(const core::StereoFrame& frame, const core::DetectorParams& params,
-                       cv::Mat& disp) {
-  if (frame.left.empty() || frame.left.type() != CV_8UC1 || frame.right.type() != CV_8UC1 ||
-      frame.left.size() != frame.right.size())
-    throw core::InputError("frame " + std::to_string(frame.index) +
-                           ": left and right must be 8-bit gray images of the same size");
-  match_bm(frame.left, frame.right, params.bm, disp);
 }
 
 }  // namespace sg::vision

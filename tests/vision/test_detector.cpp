@@ -4,6 +4,8 @@
 
 #include "sg/core/error.hpp"
 #include "sg/vision/detector.hpp"
+#include "sg/vision/frame_kernels.hpp"
+#include "sg/vision/stereo_bm.hpp"
 #include "synthetic.hpp"
 
 namespace sg::vision {
@@ -273,18 +275,24 @@ TEST(Detector, DisparitySizeChangeIsAnInputError) {
                core::InputError);
 }
 
-TEST(ComputeDisparity, MatchesBmAndRejectsMismatchedFrames) {
+TEST(FrameKernels, DisparityMatchesBmAndMismatchedFramesAreRejected) {
   const auto pair = test::shifted_pair({201, 97}, 9.0f, 21);
   core::StereoFrame f = frame(0);
   f.left = pair.left;
   f.right = pair.right;
   core::DetectorParams params;
-  cv::Mat disp;
-  compute_disparity(f, params, disp);
+  cv::Mat disp, flow;
+  check_frame(f);
+  allocate_maps(f.left.size(), /*with_flow=*/false, disp, flow);
+  disparity_rows(f, params, disp, cv::Range::all());
+  disparity_finish(params, disp);
   ASSERT_EQ(disp.size(), pair.left.size());
   EXPECT_NEAR(disp.at<float>(48, 150), 9.0f, 0.25f);
+  cv::Mat whole;
+  match_bm(f.left, f.right, params.bm, whole);
+  EXPECT_EQ(cv::countNonZero(disp != whole), 0);
   f.right = pair.right(cv::Rect(0, 0, 200, 97));
-  EXPECT_THROW(compute_disparity(f, params, disp), core::InputError);
+  EXPECT_THROW(check_frame(f), core::InputError);
 }
 
 }  // namespace

@@ -56,9 +56,4 @@ class Detector {
   RegionHysteresis hysteresis_;
 };
 
-/// Computes the disparity for a frame with the configured matcher (whole image: match_bm).
-/// Throws core::InputError when left/right are not CV_8UC1 of the same size.
-void compute_disparity(const core::StereoFrame& frame, const core::DetectorParams& params,
-                       cv::Mat& disp);
-
 }  // namespace sg::vision
