@@ -37,6 +37,30 @@ Mode parse_mode(const std::string& text) {
   throw InputError("mode=" + text + ": must be stereo or stereo-flow");
 }
 
+const char* to_string(Matcher m) {
+  switch (m) {
+    case Matcher::kBm: return "bm";
+    case Matcher::kSgbm: return "sgbm";
+    case Matcher::kFast: return "fast";
+  }
+  return "?";
+}
+
+Matcher parse_matcher(const std::string& text) {
+  if (text == "bm") return Matcher::kBm;
+  if (text == "sgbm") return Matcher::kSgbm;
+  if (text == "fast") return Matcher::kFast;
+  throw InputError("stereo.matcher=" + text + ": must be bm, sgbm or fast");
+}
+
+const char* to_string(MatchCost c) { return c == MatchCost::kSad ? "sad" : "census"; }
+
+MatchCost parse_match_cost(const std::string& text) {
+  if (text == "sad") return MatchCost::kSad;
+  if (text == "census") return MatchCost::kCensus;
+  throw InputError("stereo.cost=" + text + ": must be sad or census");
+}
+
 std::vector<std::string> validate(const BmParams& p) {
   std::vector<std::string> out;
   Checker c(out, "stereo");
@@ -52,6 +76,13 @@ std::vector<std::string> validate(const BmParams& p) {
   c.require(p.speckle_window >= 0, "speckle_window", p.speckle_window, "must be >= 0");
   c.require(p.speckle_range >= 0, "speckle_range", p.speckle_range, "must be >= 0");
   c.require(p.lr_max_diff >= -1, "lr_max_diff", p.lr_max_diff, "must be -1 (off) or >= 0");
+  if (p.matcher == Matcher::kFast) {
+    // The fast matcher sums block costs in 16-bit lanes: the largest block sum must fit.
+    const int max_pixel_cost = p.cost == MatchCost::kSad ? 2 * p.prefilter_cap : 24;
+    c.require(p.block_size * p.block_size * max_pixel_cost <= 65535, "block_size", p.block_size,
+              "too large for the fast matcher (block_size^2 * max pixel cost must be <= 65535: "
+              "block_size <= 31 with the default prefilter_cap, <= 51 with census)");
+  }
   return out;
 }
 

@@ -5,6 +5,8 @@
 #include "sg/core/error.hpp"
 #include "sg/vision/flow.hpp"
 #include "sg/vision/stereo_bm.hpp"
+#include "sg/vision/stereo_fast.hpp"
+#include "sg/vision/stereo_sgbm.hpp"
 
 namespace sg::vision {
 
@@ -18,7 +20,17 @@ void check_frame(const core::StereoFrame& frame) {
 
 void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& params,
                     cv::Mat& disp, cv::Range rows) {
-  match_bm_rows(frame.left, frame.right, params.bm, disp, rows);
+  switch (params.bm.matcher) {
+    case core::Matcher::kBm:
+      match_bm_rows(frame.left, frame.right, params.bm, disp, rows);
+      break;
+    case core::Matcher::kSgbm:
+      match_sgbm_rows(frame.left, frame.right, params.bm, disp, rows);
+      break;
+    case core::Matcher::kFast:
+      match_fast_rows(frame.left, frame.right, params.bm, disp, rows);
+      break;
+  }
 }
 
 void disparity_finish(const core::DetectorParams& params, cv::Mat& disp) {

@@ -15,8 +15,25 @@ const char* to_string(Mode m);
 /// Parses "stereo" / "stereo-flow"; throws InputError otherwise.
 Mode parse_mode(const std::string& text);
 
-/// OpenCV StereoBM settings (DESIGN 2.1).
+/// Stereo matcher (DESIGN 2.1): OpenCV StereoBM, OpenCV StereoSGBM, or our own SIMD matcher.
+enum class Matcher { kBm, kSgbm, kFast };
+/// "bm" / "sgbm" / "fast".
+const char* to_string(Matcher m);
+/// Parses "bm" / "sgbm" / "fast"; throws InputError otherwise.
+Matcher parse_matcher(const std::string& text);
+/// Matching cost of the `fast` matcher: SAD on the x-Sobel prefiltered image (as StereoBM), or
+/// the Hamming distance of 5x5 census signatures (robust to exposure differences).
+enum class MatchCost { kSad, kCensus };
+/// "sad" / "census".
+const char* to_string(MatchCost c);
+/// Parses "sad" / "census"; throws InputError otherwise.
+MatchCost parse_match_cost(const std::string& text);
+
+/// Stereo matching settings (DESIGN 2.1); the names follow OpenCV StereoBM, whose meaning the
+/// `fast` matcher keeps. `sgbm` uses the range, block size, uniqueness, speckle and lr fields.
 struct BmParams {
+  Matcher matcher = Matcher::kBm;   ///< bm (default), sgbm or fast
+  MatchCost cost = MatchCost::kSad; ///< cost of the fast matcher (bm/sgbm ignore it)
   int min_disparity = 0;        ///< px
   int num_disparities = 64;     ///< px, positive multiple of 16
   int block_size = 11;          ///< px, odd, 5..255

@@ -1,0 +1,321 @@
+// The fast matcher's SIMD kernel (Google Highway, compiled once per x86 target and dispatched at
+// run time) and its driver. The scalar reference is stereo_fast_reference.cpp.
+#include "sg/vision/stereo_fast.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cstdint>
+#include <vector>
+
+#include "stereo_fast_common.hpp"
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "src/vision/stereo_fast.cpp"
+#include <hwy/aligned_allocator.h>
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#ifndef SG_VISION_STEREO_FAST_JOB
+#define SG_VISION_STEREO_FAST_JOB
+namespace sg::vision::fast_detail {
+/// One tile's work. Input rows are counted from `ya` = y_begin - h (the first row a block reads).
+/// Right rows are stored reversed (rev[i] = right[width - 1 - i]) so that the pixels x - d of the
+/// disparities d = 0, 1, ... of one left pixel are contiguous in memory.
+struct FastJob {
+  int width = 0;
+  int num_disp = 0;  ///< multiple of 16
+  int min_disp = 0;
+  int half = 0;        ///< block_size / 2
+  int uniqueness = 0;  ///< percent
+  int lr_max_diff = -1;
+  bool census = false;
+  int y_begin = 0, y_end = 0;                ///< output rows (all inside [h, height - h))
+  const std::uint8_t* left8 = nullptr;       ///< SAD: prefiltered left rows
+  const std::uint8_t* right8_rev = nullptr;  ///< SAD: prefiltered right rows, reversed
+  size_t step8 = 0;                          ///< elements per row
+  /// Census: signatures split into planes of their low 16 and high 8 bits (16-bit lanes).
+  const std::uint16_t* left_lo = nullptr;
+  const std::uint16_t* left_hi = nullptr;
+  const std::uint16_t* right_lo_rev = nullptr;  ///< reversed like right8_rev
+  const std::uint16_t* right_hi_rev = nullptr;
+  size_t step16 = 0;
+  const std::uint8_t* texture_ok = nullptr;  ///< per output row and x: 1 = enough texture
+  size_t texture_step = 0;
+  std::int16_t* out = nullptr;  ///< per output row: disparity * 16 or kInvalid16
+  size_t out_step = 0;
+};
+}  // namespace sg::vision::fast_detail
+#endif
+
+HWY_BEFORE_NAMESPACE();
+namespace sg::vision::fast_detail {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// 16 lanes of u16 at most: every multiple of 16 disparities is a whole number of vectors on
+// every target (AVX-512 runs 256-bit vectors with its own instructions).
+using D16 = hn::CappedTag<std::uint16_t, 16>;
+
+/// V[x][d] += (kAdd) or -= the pixel costs of input row `row` for the columns x >= xb
+/// (u16 arithmetic is exact modulo 2^16 and the true sums fit in 16 bits).
+template <bool kAdd>
+void AccumulateRow(const FastJob& j, int row, std::uint16_t* HWY_RESTRICT v) {
+  const D16 d16;
+  const size_t n = hn::Lanes(d16);
+  const int xb = j.min_disp + j.num_disp - 1;
+  const int nd = j.num_disp;
+  auto apply = [&](std::uint16_t* dst, auto cost) {
+    const auto old = hn::Load(d16, dst);
+    hn::Store(kAdd ? hn::Add(old, cost) : hn::Sub(old, cost), d16, dst);
+  };
+  if (!j.census) {
+    const hn::Rebind<std::uint8_t, D16> d8;
+    const std::uint8_t* l = j.left8 + static_cast<size_t>(row) * j.step8;
+    const std::uint8_t* r = j.right8_rev + static_cast<size_t>(row) * j.step8;
+    for (int x = xb; x < j.width; ++x) {
+      const auto lv = hn::Set(d16, l[x]);
+      const std::uint8_t* rx = r + (j.width - 1 - x + j.min_disp);
+      std::uint16_t* dst = v + static_cast<size_t>(x - xb) * nd;
+      for (int d = 0; d < nd; d += static_cast<int>(n)) {
+        const auto rv = hn::PromoteTo(d16, hn::LoadU(d8, rx + d));
+        apply(dst + d, hn::Sub(hn::Max(lv, rv), hn::Min(lv, rv)));
+      }
+    }
+  } else {
+    const size_t off = static_cast<size_t>(row) * j.step16;
+    const std::uint16_t* llo = j.left_lo + off;
+    const std::uint16_t* lhi = j.left_hi + off;
+    const std::uint16_t* rlo = j.right_lo_rev + off;
+    const std::uint16_t* rhi = j.right_hi_rev + off;
+    for (int x = xb; x < j.width; ++x) {
+      const auto lo = hn::Set(d16, llo[x]), hi = hn::Set(d16, lhi[x]);
+      const size_t rx = static_cast<size_t>(j.width - 1 - x + j.min_disp);
+      std::uint16_t* dst = v + static_cast<size_t>(x - xb) * nd;
+      for (int d = 0; d < nd; d += static_cast<int>(n)) {
+        const auto c_lo = hn::PopulationCount(hn::Xor(lo, hn::LoadU(d16, rlo + rx + d)));
+        const auto c_hi = hn::PopulationCount(hn::Xor(hi, hn::LoadU(d16, rhi + rx + d)));
+        apply(dst + d, hn::Add(c_lo, c_hi));
+      }
+    }
+  }
+}
+
+void MatchRows(const FastJob& j) {
+  const D16 d16;
+  const int n = static_cast<int>(hn::Lanes(d16));
+  const int nd = j.num_disp, h = j.half;
+  const int xb = j.min_disp + nd - 1;       // first column with a full search range
+  const int x0 = xb + h, x1 = j.width - h;  // output columns
+  const int ncols = j.width - xb, nout = x1 - x0;
+  auto v = hwy::AllocateAligned<std::uint16_t>(static_cast<size_t>(ncols) * nd);
+  auto s = hwy::AllocateAligned<std::uint16_t>(static_cast<size_t>(nout) * nd);
+  std::vector<int> best(nout);
+  std::fill(v.get(), v.get() + static_cast<size_t>(ncols) * nd, std::uint16_t{0});
+  for (int row = 0; row < 2 * h + 1; ++row) AccumulateRow<true>(j, row, v.get());
+
+  for (int y = j.y_begin; y < j.y_end; ++y) {
+    const int row = y - (j.y_begin - h);  // input row of y
+    if (y > j.y_begin) {
+      AccumulateRow<true>(j, row + h, v.get());
+      AccumulateRow<false>(j, row - h - 1, v.get());
+    }
+    // Horizontal box sums, incremental along x.
+    std::uint16_t* s0 = s.get();
+    for (int d = 0; d < nd; d += n) {
+      auto acc = hn::Zero(d16);
+      for (int k = 0; k < 2 * h + 1; ++k)
+        acc = hn::Add(acc, hn::Load(d16, v.get() + static_cast<size_t>(k) * nd + d));
+      hn::Store(acc, d16, s0 + d);
+    }
+    for (int i = 1; i < nout; ++i) {
+      const std::uint16_t* add = v.get() + static_cast<size_t>(i + 2 * h) * nd;
+      const std::uint16_t* sub = v.get() + static_cast<size_t>(i - 1) * nd;
+      const std::uint16_t* prev = s.get() + static_cast<size_t>(i - 1) * nd;
+      std::uint16_t* cur = s.get() + static_cast<size_t>(i) * nd;
+      for (int d = 0; d < nd; d += n) {
+        const auto sum = hn::Sub(hn::Add(hn::Load(d16, prev + d), hn::Load(d16, add + d)),
+                                 hn::Load(d16, sub + d));
+        hn::Store(sum, d16, cur + d);
+      }
+    }
+    // Winner takes all, uniqueness, texture, sub-pixel.
+    std::int16_t* out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step;
+    const std::uint8_t* tex = j.texture_ok + static_cast<size_t>(y - j.y_begin) * j.texture_step;
+    for (int i = 0; i < nout; ++i) {
+      const std::uint16_t* c = s.get() + static_cast<size_t>(i) * nd;
+      auto vmin = hn::Load(d16, c);
+      for (int d = n; d < nd; d += n) vmin = hn::Min(vmin, hn::Load(d16, c + d));
+      const std::uint16_t m = hn::GetLane(hn::MinOfLanes(d16, vmin));
+      const auto vm = hn::Set(d16, m);
+      int b = 0;
+      for (int d = 0; d < nd; d += n) {
+        const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(hn::Load(d16, c + d), vm));
+        if (f >= 0) {
+          b = d + static_cast<int>(f);
+          break;
+        }
+      }
+      best[i] = b;
+      std::int16_t result = kInvalid16;
+      bool ok = tex[x0 + i] != 0;
+      if (ok && j.uniqueness > 0) {
+        const int thresh = std::min(m + m * j.uniqueness / 100, 65535);
+        const auto vt = hn::Set(d16, static_cast<std::uint16_t>(thresh));
+        size_t count = 0;
+        for (int d = 0; d < nd; d += n) {
+          const auto cv = hn::Load(d16, c + d);
+          count += hn::CountTrue(d16, hn::Eq(hn::Min(cv, vt), cv));
+        }
+        for (int d = std::max(b - 1, 0); d <= std::min(b + 1, nd - 1); ++d)
+          count -= c[d] <= thresh ? 1 : 0;
+        ok = count == 0;
+      }
+      if (ok) {
+        const int d16v =
+            (b > 0 && b < nd - 1) ? subpixel_disparity16(b, c[b - 1], c[b], c[b + 1]) : b * 16;
+        result = static_cast<std::int16_t>(d16v + j.min_disp * 16);
+      }
+      out[x0 + i] = result;
+    }
+    if (j.lr_max_diff >= 0) {
+      // Right image's winners: right pixel xr is seen by left pixel xr + min_disp + d at d.
+      std::vector<int> rbest(j.width, -1), rcost(j.width, INT_MAX);
+      for (int i = 0; i < nout; ++i) {
+        const std::uint16_t* c = s.get() + static_cast<size_t>(i) * nd;
+        const int x = x0 + i;
+        for (int d = 0; d < nd; ++d) {
+          const int xr = x - j.min_disp - d;
+          if (c[d] < rcost[xr] || (c[d] == rcost[xr] && d < rbest[xr])) {
+            rcost[xr] = c[d];
+            rbest[xr] = d;
+          }
+        }
+      }
+      for (int i = 0; i < nout; ++i) {
+        const int xr = x0 + i - j.min_disp - best[i];
+        if (std::abs(rbest[xr] - best[i]) > j.lr_max_diff) out[x0 + i] = kInvalid16;
+      }
+    }
+  }
+}
+
+std::int64_t CurrentTarget() { return HWY_TARGET; }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace sg::vision::fast_detail
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace sg::vision {
+namespace fast_detail {
+HWY_EXPORT(MatchRows);
+HWY_EXPORT(CurrentTarget);
+
+namespace {
+/// Copies each row of `rows` (elements of type T) through `f` into a continuous buffer, reversed
+/// when `reverse`.
+template <typename Out, typename T, typename F>
+std::vector<Out> plane(const cv::Mat& rows, bool reverse, F f) {
+  const int w = rows.cols;
+  std::vector<Out> out(static_cast<size_t>(rows.rows) * w);
+  for (int y = 0; y < rows.rows; ++y) {
+    const T* src = rows.ptr<T>(y);
+    Out* dst = out.data() + static_cast<size_t>(y) * w;
+    for (int x = 0; x < w; ++x) dst[reverse ? w - 1 - x : x] = f(src[x]);
+  }
+  return out;
+}
+}  // namespace
+}  // namespace fast_detail
+
+std::string fast_matcher_target() {
+  return hwy::TargetName(HWY_DYNAMIC_DISPATCH(fast_detail::CurrentTarget)());
+}
+
+void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmParams& p,
+                     cv::Mat& disp, cv::Range rows) {
+  using namespace fast_detail;
+  const int height = left.rows, width = left.cols;
+  if (rows == cv::Range::all()) rows = cv::Range(0, height);
+  disp.create(left.size(), CV_32F);
+  if (rows.empty()) return;
+  disp.rowRange(rows).setTo(-1.0f);
+  const int nd = p.num_disparities, md = p.min_disparity, h = p.block_size / 2;
+  const int y0 = std::max(rows.start, h), y1 = std::min(rows.end, height - h);
+  if (y0 >= y1 || md + nd - 1 + h >= width - h) return;
+  const int ya = y0 - h, yb = y1 + h;  // input rows the blocks read
+
+  FastJob job;
+  job.width = width;
+  job.num_disp = nd;
+  job.min_disp = md;
+  job.half = h;
+  job.uniqueness = p.uniqueness_ratio;
+  job.lr_max_diff = p.lr_max_diff;
+  job.census = p.cost == core::MatchCost::kCensus;
+  job.y_begin = y0;
+  job.y_end = y1;
+
+  cv::Mat pl, pr, cl, cr;
+  prefilter_rows(left, p.prefilter_cap, ya, yb, pl);  // SAD cost and texture
+  std::vector<std::uint8_t> l8, r8;
+  std::vector<std::uint16_t> llo, lhi, rlo, rhi;
+  if (!job.census) {
+    prefilter_rows(right, p.prefilter_cap, ya, yb, pr);
+    const auto same = [](std::uint8_t v) { return v; };
+    l8 = plane<std::uint8_t, std::uint8_t>(pl, false, same);
+    r8 = plane<std::uint8_t, std::uint8_t>(pr, true, same);
+    job.step8 = static_cast<size_t>(width);
+    job.left8 = l8.data();
+    job.right8_rev = r8.data();
+  } else {
+    census_rows(left, ya, yb, cl);
+    census_rows(right, ya, yb, cr);
+    const auto lo = [](int v) { return static_cast<std::uint16_t>(v & 0xFFFF); };
+    const auto hi = [](int v) { return static_cast<std::uint16_t>(v >> 16); };
+    llo = plane<std::uint16_t, int>(cl, false, lo);
+    lhi = plane<std::uint16_t, int>(cl, false, hi);
+    rlo = plane<std::uint16_t, int>(cr, true, lo);
+    rhi = plane<std::uint16_t, int>(cr, true, hi);
+    job.step16 = static_cast<size_t>(width);
+    job.left_lo = llo.data();
+    job.left_hi = lhi.data();
+    job.right_lo_rev = rlo.data();
+    job.right_hi_rev = rhi.data();
+  }
+
+  // Texture: block sums of |prefiltered - cap| from an integral image (exact integers).
+  cv::Mat integral(pl.rows + 1, width + 1, CV_32S, cv::Scalar(0));
+  for (int y = 0; y < pl.rows; ++y) {
+    const std::uint8_t* src = pl.ptr<std::uint8_t>(y);
+    const int* above = integral.ptr<int>(y);
+    int* dst = integral.ptr<int>(y + 1);
+    int row_sum = 0;
+    for (int x = 0; x < width; ++x) {
+      row_sum += std::abs(src[x] - p.prefilter_cap);
+      dst[x + 1] = above[x + 1] + row_sum;
+    }
+  }
+  cv::Mat tex_ok(y1 - y0, width, CV_8U, cv::Scalar(0));
+  const int b = 2 * h + 1;
+  for (int y = y0; y < y1; ++y) {
+    const int* top = integral.ptr<int>(y - h - ya);
+    const int* bottom = integral.ptr<int>(y - h - ya + b);
+    std::uint8_t* ok = tex_ok.ptr<std::uint8_t>(y - y0);
+    for (int x = h; x < width - h; ++x) {
+      const int sum = bottom[x + h + 1] - bottom[x - h] - top[x + h + 1] + top[x - h];
+      ok[x] = sum >= p.texture_threshold ? 1 : 0;
+    }
+  }
+  job.texture_ok = tex_ok.ptr<std::uint8_t>(0);
+  job.texture_step = tex_ok.step1();
+
+  cv::Mat out16(y1 - y0, width, CV_16S, cv::Scalar(kInvalid16));
+  job.out = out16.ptr<std::int16_t>(0);
+  job.out_step = out16.step1();
+  HWY_DYNAMIC_DISPATCH(MatchRows)(job);
+  store_disparity16(out16, y0, disp);
+}
+
+}  // namespace sg::vision
+#endif  // HWY_ONCE

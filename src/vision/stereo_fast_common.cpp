@@ -1,0 +1,82 @@
+#include "stereo_fast_common.hpp"
+
+#include <algorithm>
+
+#include "sg/vision/stereo_fast.hpp"
+
+namespace sg::vision {
+
+int subpixel_disparity16(int d, int c_minus, int c0, int c_plus) {
+  // StereoBM: fit a V through the three costs; the offset (c_minus - c_plus) / denom lies in
+  // [-1/2, 1/2] px. Truncating division then round-to-nearest in 1/16 px, as OpenCV does.
+  const int denom = c_minus + c_plus - 2 * c0 + std::abs(c_minus - c_plus);
+  const int offset256 = denom != 0 ? (c_minus - c_plus) * 256 / denom : 0;
+  return (d * 256 + offset256 + 15) >> 4;
+}
+
+namespace fast_detail {
+namespace {
+int clamp_index(int i, int n) { return std::clamp(i, 0, n - 1); }
+}  // namespace
+
+void prefilter_rows(const cv::Mat& img, int cap, int r0, int r1, cv::Mat& out) {
+  const int width = img.cols, height = img.rows;
+  out.create(r1 - r0, width, CV_8U);
+  std::vector<int> tab(2 * 1024 + 1);
+  for (int v = -1024; v <= 1024; ++v) tab[v + 1024] = std::clamp(v, -cap, cap) + cap;
+  for (int y = r0; y < r1; ++y) {
+    const std::uint8_t* a = img.ptr<std::uint8_t>(clamp_index(y - 1, height));
+    const std::uint8_t* b = img.ptr<std::uint8_t>(y);
+    const std::uint8_t* c = img.ptr<std::uint8_t>(clamp_index(y + 1, height));
+    std::uint8_t* o = out.ptr<std::uint8_t>(y - r0);
+    auto at = [&](int x) {
+      const int xl = clamp_index(x - 1, width), xr = clamp_index(x + 1, width);
+      const int v = (a[xr] - a[xl]) + 2 * (b[xr] - b[xl]) + (c[xr] - c[xl]);
+      return static_cast<std::uint8_t>(tab[v + 1024]);
+    };
+    o[0] = at(0);
+    for (int x = 1; x + 1 < width; ++x) {
+      const int v = (a[x + 1] - a[x - 1]) + 2 * (b[x + 1] - b[x - 1]) + (c[x + 1] - c[x - 1]);
+      o[x] = static_cast<std::uint8_t>(std::clamp(v, -cap, cap) + cap);
+    }
+    if (width > 1) o[width - 1] = at(width - 1);
+  }
+}
+
+void census_rows(const cv::Mat& img, int r0, int r1, cv::Mat& out) {
+  const int width = img.cols, height = img.rows, r = kCensusRadius;
+  out.create(r1 - r0, width, CV_32S);
+  // Rows padded by r on each side so that the inner loop has no branches.
+  std::vector<std::uint8_t> pad(static_cast<size_t>(2 * r + 1) * (width + 2 * r));
+  const int pw = width + 2 * r;
+  for (int y = r0; y < r1; ++y) {
+    for (int k = -r; k <= r; ++k) {
+      const std::uint8_t* src = img.ptr<std::uint8_t>(clamp_index(y + k, height));
+      std::uint8_t* dst = pad.data() + static_cast<size_t>(k + r) * pw;
+      for (int x = -r; x < width + r; ++x) dst[x + r] = src[clamp_index(x, width)];
+    }
+    std::uint32_t* o = reinterpret_cast<std::uint32_t*>(out.ptr<std::int32_t>(y - r0));
+    const std::uint8_t* centre = pad.data() + static_cast<size_t>(r) * pw + r;
+    for (int x = 0; x < width; ++x) o[x] = 0;
+    for (int dy = -r; dy <= r; ++dy) {
+      for (int dx = -r; dx <= r; ++dx) {
+        if (dy == 0 && dx == 0) continue;
+        const std::uint8_t* nb = pad.data() + static_cast<size_t>(dy + r) * pw + r + dx;
+        for (int x = 0; x < width; ++x)
+          o[x] = (o[x] << 1) | static_cast<std::uint32_t>(nb[x] < centre[x]);
+      }
+    }
+  }
+}
+
+void store_disparity16(const cv::Mat& rows16, int y0, cv::Mat& disp) {
+  for (int i = 0; i < rows16.rows; ++i) {
+    const std::int16_t* src = rows16.ptr<std::int16_t>(i);
+    float* dst = disp.ptr<float>(y0 + i);
+    for (int x = 0; x < rows16.cols; ++x)
+      dst[x] = src[x] == kInvalid16 ? -1.0f : static_cast<float>(src[x]) / 16.0f;
+  }
+}
+
+}  // namespace fast_detail
+}  // namespace sg::vision
