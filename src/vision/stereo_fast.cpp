@@ -52,56 +52,45 @@ namespace sg::vision::fast_detail {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// 16 lanes of u16 at most: every multiple of 16 disparities is a whole number of vectors on
-// every target (AVX-512 runs 256-bit vectors with its own instructions).
-using D16 = hn::CappedTag<std::uint16_t, 16>;
-
-/// V[x][d] += (kAdd) or -= the pixel costs of input row `row` for the columns x >= xb
-/// (u16 arithmetic is exact modulo 2^16 and the true sums fit in 16 bits).
-template <bool kAdd>
-void AccumulateRow(const FastJob& j, int row, std::uint16_t* HWY_RESTRICT v) {
-  const D16 d16;
-  const size_t n = hn::Lanes(d16);
-  const int xb = j.min_disp + j.num_disp - 1;
-  const int nd = j.num_disp;
-  auto apply = [&](std::uint16_t* dst, auto cost) {
-    const auto old = hn::Load(d16, dst);
-    hn::Store(kAdd ? hn::Add(old, cost) : hn::Sub(old, cost), d16, dst);
-  };
-  if (!j.census) {
+/// Pixel costs of input row `off` (element offset of the row) for column x and the disparities
+/// [d, d + Lanes(d16)): |left - right| of the prefiltered images or census Hamming distances.
+template <bool kCensus, class D16>
+HWY_INLINE hn::Vec<D16> CostAt(D16 d16, const FastJob& j, size_t off, int x, int d) {
+  const size_t rx = off + static_cast<size_t>(j.width - 1 - x + j.min_disp + d);
+  if constexpr (!kCensus) {
     const hn::Rebind<std::uint8_t, D16> d8;
-    const std::uint8_t* l = j.left8 + static_cast<size_t>(row) * j.step8;
-    const std::uint8_t* r = j.right8_rev + static_cast<size_t>(row) * j.step8;
-    for (int x = xb; x < j.width; ++x) {
-      const auto lv = hn::Set(d16, l[x]);
-      const std::uint8_t* rx = r + (j.width - 1 - x + j.min_disp);
-      std::uint16_t* dst = v + static_cast<size_t>(x - xb) * nd;
-      for (int d = 0; d < nd; d += static_cast<int>(n)) {
-        const auto rv = hn::PromoteTo(d16, hn::LoadU(d8, rx + d));
-        apply(dst + d, hn::Sub(hn::Max(lv, rv), hn::Min(lv, rv)));
-      }
-    }
+    const auto lv = hn::Set(d16, j.left8[off + x]);
+    const auto rv = hn::PromoteTo(d16, hn::LoadU(d8, j.right8_rev + rx));
+    return hn::Sub(hn::Max(lv, rv), hn::Min(lv, rv));
   } else {
-    const size_t off = static_cast<size_t>(row) * j.step16;
-    const std::uint16_t* llo = j.left_lo + off;
-    const std::uint16_t* lhi = j.left_hi + off;
-    const std::uint16_t* rlo = j.right_lo_rev + off;
-    const std::uint16_t* rhi = j.right_hi_rev + off;
-    for (int x = xb; x < j.width; ++x) {
-      const auto lo = hn::Set(d16, llo[x]), hi = hn::Set(d16, lhi[x]);
-      const size_t rx = static_cast<size_t>(j.width - 1 - x + j.min_disp);
-      std::uint16_t* dst = v + static_cast<size_t>(x - xb) * nd;
-      for (int d = 0; d < nd; d += static_cast<int>(n)) {
-        const auto c_lo = hn::PopulationCount(hn::Xor(lo, hn::LoadU(d16, rlo + rx + d)));
-        const auto c_hi = hn::PopulationCount(hn::Xor(hi, hn::LoadU(d16, rhi + rx + d)));
-        apply(dst + d, hn::Add(c_lo, c_hi));
-      }
+    const auto lo = hn::Xor(hn::Set(d16, j.left_lo[off + x]), hn::LoadU(d16, j.right_lo_rev + rx));
+    const auto hi = hn::Xor(hn::Set(d16, j.left_hi[off + x]), hn::LoadU(d16, j.right_hi_rev + rx));
+    return hn::Add(hn::PopulationCount(lo), hn::PopulationCount(hi));
+  }
+}
+
+/// Column sums V[x][d] for the columns x >= xb: adds the costs of input row `add` and, when
+/// sub >= 0, subtracts those of row `sub` (u16 arithmetic is exact modulo 2^16 and the true sums
+/// fit in 16 bits, so the result is exact).
+template <bool kCensus, class D16>
+void UpdateColumns(D16 d16, const FastJob& j, int add, int sub, std::uint16_t* HWY_RESTRICT v) {
+  const int n = static_cast<int>(hn::Lanes(d16));
+  const int xb = j.min_disp + j.num_disp - 1, nd = j.num_disp;
+  const size_t step = kCensus ? j.step16 : j.step8;
+  const size_t off_add = static_cast<size_t>(add) * step;
+  const size_t off_sub = static_cast<size_t>(sub < 0 ? 0 : sub) * step;
+  for (int x = xb; x < j.width; ++x) {
+    std::uint16_t* dst = v + static_cast<size_t>(x - xb) * nd;
+    for (int d = 0; d < nd; d += n) {
+      auto acc = hn::Add(hn::Load(d16, dst + d), CostAt<kCensus>(d16, j, off_add, x, d));
+      if (sub >= 0) acc = hn::Sub(acc, CostAt<kCensus>(d16, j, off_sub, x, d));
+      hn::Store(acc, d16, dst + d);
     }
   }
 }
 
-void MatchRows(const FastJob& j) {
-  const D16 d16;
+template <bool kCensus, class D16>
+void MatchRowsT(D16 d16, const FastJob& j) {
   const int n = static_cast<int>(hn::Lanes(d16));
   const int nd = j.num_disp, h = j.half;
   const int xb = j.min_disp + nd - 1;       // first column with a full search range
@@ -111,14 +100,11 @@ void MatchRows(const FastJob& j) {
   auto s = hwy::AllocateAligned<std::uint16_t>(static_cast<size_t>(nout) * nd);
   std::vector<int> best(nout);
   std::fill(v.get(), v.get() + static_cast<size_t>(ncols) * nd, std::uint16_t{0});
-  for (int row = 0; row < 2 * h + 1; ++row) AccumulateRow<true>(j, row, v.get());
+  for (int row = 0; row < 2 * h + 1; ++row) UpdateColumns<kCensus>(d16, j, row, -1, v.get());
 
   for (int y = j.y_begin; y < j.y_end; ++y) {
     const int row = y - (j.y_begin - h);  // input row of y
-    if (y > j.y_begin) {
-      AccumulateRow<true>(j, row + h, v.get());
-      AccumulateRow<false>(j, row - h - 1, v.get());
-    }
+    if (y > j.y_begin) UpdateColumns<kCensus>(d16, j, row + h, row - h - 1, v.get());
     // Horizontal box sums, incremental along x.
     std::uint16_t* s0 = s.get();
     for (int d = 0; d < nd; d += n) {
@@ -142,40 +128,37 @@ void MatchRows(const FastJob& j) {
     std::int16_t* out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step;
     const std::uint8_t* tex = j.texture_ok + static_cast<size_t>(y - j.y_begin) * j.texture_step;
     for (int i = 0; i < nout; ++i) {
+      out[x0 + i] = kInvalid16;
+      if (!tex[x0 + i]) continue;
       const std::uint16_t* c = s.get() + static_cast<size_t>(i) * nd;
       auto vmin = hn::Load(d16, c);
       for (int d = n; d < nd; d += n) vmin = hn::Min(vmin, hn::Load(d16, c + d));
       const std::uint16_t m = hn::GetLane(hn::MinOfLanes(d16, vmin));
       const auto vm = hn::Set(d16, m);
-      int b = 0;
+      int b = -1;
+      size_t count = 0;  // disparities within the uniqueness threshold
+      const int thresh = j.uniqueness > 0 ? std::min(m + m * j.uniqueness / 100, 65535) : -1;
+      const auto vt = hn::Set(d16, static_cast<std::uint16_t>(std::max(thresh, 0)));
       for (int d = 0; d < nd; d += n) {
-        const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(hn::Load(d16, c + d), vm));
-        if (f >= 0) {
-          b = d + static_cast<int>(f);
-          break;
+        const auto cv = hn::Load(d16, c + d);
+        if (b < 0) {
+          const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(cv, vm));
+          if (f >= 0) b = d + static_cast<int>(f);
         }
+        if (thresh >= 0)
+          count += hn::CountTrue(d16, hn::Eq(hn::Min(cv, vt), cv));
+        else if (b >= 0)
+          break;
       }
       best[i] = b;
-      std::int16_t result = kInvalid16;
-      bool ok = tex[x0 + i] != 0;
-      if (ok && j.uniqueness > 0) {
-        const int thresh = std::min(m + m * j.uniqueness / 100, 65535);
-        const auto vt = hn::Set(d16, static_cast<std::uint16_t>(thresh));
-        size_t count = 0;
-        for (int d = 0; d < nd; d += n) {
-          const auto cv = hn::Load(d16, c + d);
-          count += hn::CountTrue(d16, hn::Eq(hn::Min(cv, vt), cv));
-        }
+      if (thresh >= 0) {
         for (int d = std::max(b - 1, 0); d <= std::min(b + 1, nd - 1); ++d)
           count -= c[d] <= thresh ? 1 : 0;
-        ok = count == 0;
+        if (count != 0) continue;
       }
-      if (ok) {
-        const int d16v =
-            (b > 0 && b < nd - 1) ? subpixel_disparity16(b, c[b - 1], c[b], c[b + 1]) : b * 16;
-        result = static_cast<std::int16_t>(d16v + j.min_disp * 16);
-      }
-      out[x0 + i] = result;
+      const int d16v =
+          (b > 0 && b < nd - 1) ? subpixel_disparity16(b, c[b - 1], c[b], c[b + 1]) : b * 16;
+      out[x0 + i] = static_cast<std::int16_t>(d16v + j.min_disp * 16);
     }
     if (j.lr_max_diff >= 0) {
       // Right image's winners: right pixel xr is seen by left pixel xr + min_disp + d at d.
@@ -192,10 +175,30 @@ void MatchRows(const FastJob& j) {
         }
       }
       for (int i = 0; i < nout; ++i) {
+        if (out[x0 + i] == kInvalid16) continue;
         const int xr = x0 + i - j.min_disp - best[i];
         if (std::abs(rbest[xr] - best[i]) > j.lr_max_diff) out[x0 + i] = kInvalid16;
       }
     }
+  }
+}
+
+/// Full-width vectors when the range is a whole number of them (AVX-512: 32 lanes), else at
+/// most 16 lanes, which every multiple of 16 disparities fills.
+void MatchRows(const FastJob& j) {
+  const hn::ScalableTag<std::uint16_t> full;
+  const hn::CappedTag<std::uint16_t, 16> capped;
+  const bool use_full = j.num_disp % static_cast<int>(hn::Lanes(full)) == 0;
+  if (j.census) {
+    if (use_full)
+      MatchRowsT<true>(full, j);
+    else
+      MatchRowsT<true>(capped, j);
+  } else {
+    if (use_full)
+      MatchRowsT<false>(full, j);
+    else
+      MatchRowsT<false>(capped, j);
   }
 }
 

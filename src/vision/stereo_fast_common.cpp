@@ -6,14 +6,6 @@
 
 namespace sg::vision {
 
-int subpixel_disparity16(int d, int c_minus, int c0, int c_plus) {
-  // StereoBM: fit a V through the three costs; the offset (c_minus - c_plus) / denom lies in
-  // [-1/2, 1/2] px. Truncating division then round-to-nearest in 1/16 px, as OpenCV does.
-  const int denom = c_minus + c_plus - 2 * c0 + std::abs(c_minus - c_plus);
-  const int offset256 = denom != 0 ? (c_minus - c_plus) * 256 / denom : 0;
-  return (d * 256 + offset256 + 15) >> 4;
-}
-
 namespace fast_detail {
 namespace {
 int clamp_index(int i, int n) { return std::clamp(i, 0, n - 1); }

@@ -41,6 +41,13 @@ std::string fast_matcher_target();
 /// Sub-pixel disparity as StereoBM computes it, in 1/16 px: winner d (integer, px, relative or
 /// absolute) with block costs c_minus at d - 1, c0 at d, c_plus at d + 1 (c0 the smallest). The
 /// one place both the SIMD matcher and its reference refine. Integer arithmetic, exact.
-int subpixel_disparity16(int d, int c_minus, int c0, int c_plus);
+inline int subpixel_disparity16(int d, int c_minus, int c0, int c_plus) {
+  // Fit a V through the three costs: the offset (c_minus - c_plus) / denom lies in [-1/2, 1/2]
+  // px. Truncating division, then round to the nearest 1/16 px, as OpenCV does.
+  const int diff = c_minus - c_plus;
+  const int denom = c_minus + c_plus - 2 * c0 + (diff < 0 ? -diff : diff);
+  const int offset256 = denom != 0 ? diff * 256 / denom : 0;
+  return (d * 256 + offset256 + 15) >> 4;
+}
 
 }  // namespace sg::vision
