@@ -20,6 +20,7 @@ struct BenchArgs {
   std::vector<double> pace = {0.8, 1.5};
   int frames = 300;
   int num_disparities = 64;
+  std::string matcher = "bm", cost = "sad";
   int threads = 0;
   std::string scenario = "head-on";
   std::string csv = "stereoguard-bench.csv";
@@ -82,6 +83,8 @@ void bench_main(const BenchArgs& a) {
   for (const auto& r : a.resolutions) config.resolutions.push_back(parse_resolution(r));
   config.frames = a.frames;
   config.num_disparities = a.num_disparities;
+  config.matcher = core::parse_matcher(a.matcher);
+  config.cost = core::parse_match_cost(a.cost);
   config.threads = a.threads;
   config.scenario = a.scenario;
   config.pace_fractions = a.pace;
@@ -118,6 +121,10 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--resolutions", a->resolutions, "e.g. 640x480,1242x375")->delimiter(',');
   cmd->add_option("--frames", a->frames, "frames per configuration (default 300)");
   cmd->add_option("--num-disparities", a->num_disparities, "stereo search range (default 64)");
+  cmd->add_option("--matcher", a->matcher,
+                  "stereo matcher of the pipeline rows: bm (default), sgbm or fast (the baselines "
+                  "stay StereoBM)");
+  cmd->add_option("--cost", a->cost, "fast matcher cost: sad (default) or census");
   cmd->add_option("--threads", a->threads, "task-arena size (default 0 = all cores)");
   cmd->add_option("--scenario", a->scenario, "scenario rendered for the frames (default head-on)");
   cmd->add_option("--pace", a->pace,

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "eval_stereo.hpp"
 #include "options.hpp"
 #include "sg/core/error.hpp"
 #include "sg/eval/flow_metrics.hpp"
@@ -30,6 +31,10 @@ struct EvalArgs {
   bool flow = false;
   std::string left, right, gt, dir;
   std::string flow_methods = "all";
+  // --stereo: stereo accuracy against GT disparity.
+  bool stereo = false;
+  double gt_scale = 0;
+  std::string matchers = "bm,sgbm,fast,fast-census";
 };
 
 /// Two images and the forward GT flow from the first to the second.
@@ -169,6 +174,20 @@ void eval_main(const EvalArgs& args) {
     eval_flow_main(args);
     return;
   }
+  if (args.stereo) {
+    StereoEvalArgs s;
+    s.left = args.left;
+    s.right = args.right;
+    s.gt = args.gt;
+    s.dir = args.dir;
+    s.gt_scale = args.gt_scale;
+    s.matchers = args.matchers;
+    s.json = args.json;
+    s.base = make_run_options(args.detector).params.bm;
+    s.auto_range = !args.detector.num_disparities.has_value();
+    eval_stereo_main(s);
+    return;
+  }
   const pipeline::RunOptions options = make_run_options(args.detector);
   OpenedInput in = open_input(args.input);
   pipeline::TruthLookup truth_of;
@@ -211,14 +230,25 @@ void add_eval_command(CLI::App& app) {
   add_input_options(*cmd, args->input);
   add_detector_options(*cmd, args->detector);
   cmd->add_option("--json", args->json, "write the metrics as JSON");
-  cmd->add_flag("--flow", args->flow,
+  auto* flow_flag = cmd->add_flag("--flow", args->flow,
                 "optical-flow accuracy instead: EPE and bad-3px % against a forward GT .flo");
   cmd->add_option("--left", args->left, "with --flow: first image (frame 1)");
   cmd->add_option("--right", args->right, "with --flow: second image (frame 2)");
   cmd->add_option("--gt", args->gt, "with --flow: GT flow from frame 1 to frame 2 (.flo)");
   cmd->add_option("--dir", args->dir,
                   "with --flow: a folder of pairs (NAME1/NAME2.png + NAME.flo, or "
-                  "ID-img0/ID-img1 + ID-gt.flo), and its subfolders");
+                  "ID-img0/ID-img1 + ID-gt.flo), and its subfolders; with --stereo: a stereo GT "
+                  "dataset (Middlebury, KITTI layouts; see README)");
+  cmd->add_flag("--stereo", args->stereo,
+                "stereo accuracy instead: bad-1/2/4 %, MAE, density per matcher against GT "
+                "disparity (--dir DATASET, or --left/--right/--gt)")
+      ->excludes(flow_flag);
+  cmd->add_option("--gt-scale", args->gt_scale,
+                  "with --stereo: 8-bit GT PNG scale, disparity = value / scale (default 0 = "
+                  "from the folder's datasets.xml)");
+  cmd->add_option("--matchers", args->matchers,
+                  "with --stereo: bm, sgbm, fast, fast-sad, fast-census, comma-separated "
+                  "(default all but fast-sad)");
   cmd->add_option("--flow-methods", args->flow_methods,
                   "with --flow: dis-ultrafast, dis-fast, dis-medium, farneback or all (default)");
   cmd->callback([args] { eval_main(*args); });

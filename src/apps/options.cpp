@@ -37,6 +37,10 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
   app.add_option("--num-disparities", o.num_disparities,
                  "stereo search range, px (positive multiple of 16; default 64)");
   app.add_option("--block-size", o.block_size, "stereo block size, px (odd, 5..255)");
+  app.add_option("--matcher", o.matcher,
+                 "stereo matcher: bm (OpenCV StereoBM, default), sgbm (OpenCV StereoSGBM) or fast "
+                 "(our SIMD block matcher)");
+  app.add_option("--cost", o.cost, "fast matcher cost: sad (default) or census");
   app.add_option("--gaps", o.gaps,
                  "frame gaps k compared by the mode's labelling, e.g. --gaps 1 (the thesis) or "
                  "1,4,10 (Stereo mode default 1,5,15; Stereo-Flow 1,4,10,20)")
@@ -66,6 +70,8 @@ pipeline::RunOptions make_run_options(const DetectorOptions& o) {
   if (o.mode) run.params.mode = core::parse_mode(*o.mode);
   if (o.num_disparities) run.params.bm.num_disparities = *o.num_disparities;
   if (o.block_size) run.params.bm.block_size = *o.block_size;
+  if (o.matcher) run.params.bm.matcher = core::parse_matcher(*o.matcher);
+  if (o.cost) run.params.bm.cost = core::parse_match_cost(*o.cost);
   if (o.gaps) {
     if (run.params.mode == core::Mode::kStereoFlow)
       run.params.scene_flow.gaps = *o.gaps;

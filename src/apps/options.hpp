@@ -36,6 +36,7 @@ OpenedInput open_input(const InputOptions& options);
 struct DetectorOptions {
   std::string config;
   std::optional<std::string> mode;
+  std::optional<std::string> matcher, cost;
   std::optional<int> num_disparities, block_size, min_area;
   std::optional<std::vector<int>> gaps;
   std::optional<std::string> flow_method;

@@ -84,7 +84,10 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .section("scene_flow")
         .done();
     p.mode = core::parse_mode(mode);
+    std::string matcher = core::to_string(p.bm.matcher), cost = core::to_string(p.bm.cost);
     Section(root["stereo"], "stereo")
+        .field("matcher", matcher)
+        .field("cost", cost)
         .field("min_disparity", p.bm.min_disparity)
         .field("num_disparities", p.bm.num_disparities)
         .field("block_size", p.bm.block_size)
@@ -95,6 +98,8 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("speckle_range", p.bm.speckle_range)
         .field("lr_max_diff", p.bm.lr_max_diff)
         .done();
+    p.bm.matcher = core::parse_matcher(matcher);
+    p.bm.cost = core::parse_match_cost(cost);
     Section(root["label"], "label")
         .field("gaps", p.stereo.gaps)
         .field("z_max_m", p.stereo.z_max_m)

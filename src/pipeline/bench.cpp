@@ -182,6 +182,8 @@ std::vector<BenchRow> run_bench(const BenchConfig& config,
       RunOptions options;
       options.params.mode = mode;
       options.params.bm.num_disparities = config.num_disparities;
+      options.params.bm.matcher = config.matcher;
+      options.params.bm.cost = config.cost;
       options.threads = config.threads;
       core::throw_if_invalid(validate(options, scenario.camera), "invalid bench settings");
 

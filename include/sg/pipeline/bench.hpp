@@ -18,6 +18,9 @@ struct BenchConfig {
   std::vector<cv::Size> resolutions = {{640, 480}, {1242, 375}};
   int frames = 300;          ///< frames per configuration
   int num_disparities = 64;  ///< stereo search range, px
+  /// Matcher of the pipeline rows (the baseline loops stay StereoBM, the reference).
+  core::Matcher matcher = core::Matcher::kBm;
+  core::MatchCost cost = core::MatchCost::kSad;  ///< fast matcher's cost
   int threads = 0;           ///< task-arena size (0 = all cores)
   std::string scenario = "head-on";
   /// Also run the best configuration of each mode (first resolution) paced at these fractions of

@@ -1,0 +1,170 @@
+#include "sg/io/stereo_gt.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <regex>
+#include <sstream>
+
+#include "sg/core/error.hpp"
+#include "sg/io/gt_formats.hpp"
+
+namespace sg::io {
+namespace fs = std::filesystem;
+namespace {
+
+bool little_endian_host() {
+  const std::uint16_t one = 1;
+  unsigned char b;
+  std::memcpy(&b, &one, 1);
+  return b == 1;
+}
+
+/// Scales listed in an OpenCV datasets.xml (lines `name "scale" "unknown"`); empty if none.
+std::map<std::string, double> read_dataset_scales(const fs::path& xml) {
+  std::map<std::string, double> out;
+  std::ifstream in(xml);
+  const std::regex line(R"(^\s*([A-Za-z0-9_\-]+)\s+\"([0-9.]+)\"\s+\"[0-9.]+\"\s*$)");
+  std::string text;
+  std::smatch m;
+  while (std::getline(in, text))
+    if (std::regex_match(text, m, line)) out[m[1]] = std::stod(m[2]);
+  return out;
+}
+
+double scale_for(const fs::path& scene_dir, double fallback) {
+  for (const fs::path& xml :
+       {scene_dir / "datasets.xml", scene_dir.parent_path() / "datasets.xml"}) {
+    if (!fs::exists(xml)) continue;
+    const auto scales = read_dataset_scales(xml);
+    const auto it = scales.find(scene_dir.filename().string());
+    if (it != scales.end()) return it->second;
+  }
+  return fallback;
+}
+
+/// Pairs of one folder (no recursion).
+void pairs_in(const fs::path& dir, double scale, std::vector<StereoGtPair>& out) {
+  auto has = [&](const char* f) { return fs::exists(dir / f); };
+  const std::string name = dir.filename().string();
+  if (has("im2.png") && has("im6.png") && has("disp2.png")) {
+    out.push_back(
+        {name, dir / "im2.png", dir / "im6.png", dir / "disp2.png", scale_for(dir, scale)});
+  } else if (has("view1.png") && has("view5.png") && has("disp1.png")) {
+    out.push_back(
+        {name, dir / "view1.png", dir / "view5.png", dir / "disp1.png", scale_for(dir, scale)});
+  } else if (has("im0.png") && has("im1.png") && (has("disp0GT.pfm") || has("disp0.pfm"))) {
+    out.push_back({name, dir / "im0.png", dir / "im1.png",
+                   dir / (has("disp0GT.pfm") ? "disp0GT.pfm" : "disp0.pfm"), 0});
+  }
+  // KITTI: the first matching camera and GT folders.
+  fs::path left_dir, right_dir, gt_dir;
+  for (const char* l : {"image_2", "image_0"})
+    if (fs::is_directory(dir / l) && left_dir.empty()) left_dir = dir / l;
+  for (const char* r : {"image_3", "image_1"})
+    if (fs::is_directory(dir / r) && right_dir.empty()) right_dir = dir / r;
+  for (const char* g : {"disp_noc_0", "disp_noc"})
+    if (fs::is_directory(dir / g) && gt_dir.empty()) gt_dir = dir / g;
+  if (left_dir.empty() || right_dir.empty() || gt_dir.empty()) return;
+  for (const auto& e : fs::directory_iterator(gt_dir)) {
+    const fs::path file = e.path().filename();
+    if (file.extension() != ".png") continue;
+    if (fs::exists(left_dir / file) && fs::exists(right_dir / file))
+      out.push_back({file.stem().string(), left_dir / file, right_dir / file, e.path(), 0});
+  }
+}
+
+}  // namespace
+
+cv::Mat read_pfm(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError("cannot open PFM file " + path.string());
+  std::string tag;
+  int width = 0, height = 0;
+  double scale = 0;
+  in >> tag >> width >> height >> scale;
+  if (tag != "Pf" || !in || width <= 0 || height <= 0 || width > 65536 || height > 65536 ||
+      scale == 0) {
+    throw core::InputError(path.string() + ": not a one-channel PFM file (\"Pf\" header)");
+  }
+  in.get();  // the single whitespace byte after the scale
+  cv::Mat out(height, width, CV_32F);
+  const bool swap = (scale < 0) != little_endian_host();
+  std::vector<unsigned char> row(static_cast<size_t>(width) * 4);
+  for (int y = height - 1; y >= 0; --y) {  // bottom row first
+    if (!in.read(reinterpret_cast<char*>(row.data()), static_cast<std::streamsize>(row.size())))
+      throw core::InputError(path.string() + ": PFM file is truncated");
+    float* dst = out.ptr<float>(y);
+    for (int x = 0; x < width; ++x) {
+      unsigned char* b = &row[static_cast<size_t>(x) * 4];
+      if (swap) {
+        std::swap(b[0], b[3]);
+        std::swap(b[1], b[2]);
+      }
+      float v;
+      std::memcpy(&v, b, 4);
+      dst[x] = std::isfinite(v) && v > 0 ? v : 0.0f;
+    }
+  }
+  return out;
+}
+
+void write_pfm(const fs::path& path, const cv::Mat& disparity) {
+  CV_Assert(disparity.type() == CV_32F);
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw core::InputError("cannot write " + path.string());
+  const bool le = little_endian_host();
+  out << "Pf\n" << disparity.cols << " " << disparity.rows << "\n" << (le ? "-1.0" : "1.0") << "\n";
+  for (int y = disparity.rows - 1; y >= 0; --y)
+    out.write(reinterpret_cast<const char*>(disparity.ptr<float>(y)),
+              static_cast<std::streamsize>(disparity.cols * sizeof(float)));
+}
+
+cv::Mat read_middlebury_png(const fs::path& path, double scale) {
+  if (!(scale > 0)) throw core::InputError("gt_scale=" + std::to_string(scale) + ": must be > 0");
+  cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  if (raw.empty()) throw core::InputError("cannot read GT disparity " + path.string());
+  if (raw.depth() != CV_8U)
+    throw core::InputError(path.string() + ": Middlebury GT must be an 8-bit PNG");
+  if (raw.channels() != 1) cv::extractChannel(raw, raw, 0);
+  cv::Mat out;
+  raw.convertTo(out, CV_32F, 1.0 / scale);
+  return out;
+}
+
+cv::Mat read_stereo_gt(const fs::path& path, double scale) {
+  if (path.extension() == ".pfm") return read_pfm(path);
+  cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  if (raw.empty()) throw core::InputError("cannot read GT disparity " + path.string());
+  if (raw.depth() == CV_16U) return read_disparity_png(path);
+  if (!(scale > 0)) {
+    throw core::InputError(path.string() +
+                           ": 8-bit GT needs its scale (disparity = value / scale): give "
+                           "--gt-scale or a datasets.xml");
+  }
+  return read_middlebury_png(path, scale);
+}
+
+std::vector<StereoGtPair> find_stereo_gt_pairs(const fs::path& dir, double scale) {
+  if (!fs::is_directory(dir)) throw core::InputError(dir.string() + " is not a folder");
+  std::vector<StereoGtPair> out;
+  pairs_in(dir, scale, out);
+  std::vector<fs::path> subdirs;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_directory()) subdirs.push_back(e.path());
+  std::sort(subdirs.begin(), subdirs.end());
+  for (const auto& d : subdirs) pairs_in(d, scale, out);
+  if (out.empty()) {
+    throw core::InputError(dir.string() +
+                           " holds no stereo pair with GT (im2/im6/disp2.png, im0/im1.png + "
+                           "disp0GT.pfm, or KITTI image_2/image_3/disp_noc_0)");
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const auto& a, const auto& b) { return a.name < b.name; });
+  return out;
+}
+
+}  // namespace sg::io
