@@ -12,26 +12,25 @@ int clamp_index(int i, int n) { return std::clamp(i, 0, n - 1); }
 }  // namespace
 
 void prefilter_rows(const cv::Mat& img, int cap, int r0, int r1, cv::Mat& out) {
+  // Borders as StereoBM's prefilter: rows reflected without repeating the edge (row -1 = row 1),
+  // first and last columns set to cap (no gradient).
   const int width = img.cols, height = img.rows;
   out.create(r1 - r0, width, CV_8U);
-  std::vector<int> tab(2 * 1024 + 1);
-  for (int v = -1024; v <= 1024; ++v) tab[v + 1024] = std::clamp(v, -cap, cap) + cap;
+  auto reflect = [height](int y) {
+    if (height == 1) return 0;
+    return y < 0 ? -y : (y >= height ? 2 * height - 2 - y : y);
+  };
   for (int y = r0; y < r1; ++y) {
-    const std::uint8_t* a = img.ptr<std::uint8_t>(clamp_index(y - 1, height));
+    const std::uint8_t* a = img.ptr<std::uint8_t>(reflect(y - 1));
     const std::uint8_t* b = img.ptr<std::uint8_t>(y);
-    const std::uint8_t* c = img.ptr<std::uint8_t>(clamp_index(y + 1, height));
+    const std::uint8_t* c = img.ptr<std::uint8_t>(reflect(y + 1));
     std::uint8_t* o = out.ptr<std::uint8_t>(y - r0);
-    auto at = [&](int x) {
-      const int xl = clamp_index(x - 1, width), xr = clamp_index(x + 1, width);
-      const int v = (a[xr] - a[xl]) + 2 * (b[xr] - b[xl]) + (c[xr] - c[xl]);
-      return static_cast<std::uint8_t>(tab[v + 1024]);
-    };
-    o[0] = at(0);
+    o[0] = static_cast<std::uint8_t>(cap);
     for (int x = 1; x + 1 < width; ++x) {
       const int v = (a[x + 1] - a[x - 1]) + 2 * (b[x + 1] - b[x - 1]) + (c[x + 1] - c[x - 1]);
       o[x] = static_cast<std::uint8_t>(std::clamp(v, -cap, cap) + cap);
     }
-    if (width > 1) o[width - 1] = at(width - 1);
+    o[width - 1] = static_cast<std::uint8_t>(cap);
   }
 }
 

@@ -432,3 +432,43 @@ TEST_F(Cli, EvalFlowOnMiddleburyAndFlyingChairs) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(Cli, UnknownMatcherIsAUserError) {
+  expect_user_error(run("run --scenario '" + small_scenario().string() + "' --matcher nope"),
+                    "matcher=nope");
+}
+
+TEST_F(Cli, FastMatcherBlockTooLargeIsAUserError) {
+  expect_user_error(run("run --scenario '" + small_scenario().string() +
+                        "' --matcher fast --block-size 41"),
+                    "block_size=41");
+}
+
+TEST_F(Cli, StereoEvalNeedsItsInputs) {
+  expect_user_error(run("eval --stereo --left a.png"), "--stereo needs");
+  expect_user_error(run("eval --stereo --dir no-such-dir"), "not a folder");
+}
+
+TEST_F(Cli, StereoEvalOnAPairWritesJsonPerMatcher) {
+  // A synthetic pair: right = left shifted by 8 px; GT 8 px stored 8-bit with scale 4.
+  cv::Mat wide(120, 200, CV_8U);
+  cv::RNG(3).fill(wide, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(wide, wide, cv::Size(0, 0), 1.0);
+  cv::imwrite((dir_ / "l.png").string(), wide(cv::Rect(0, 0, 160, 120)));
+  cv::imwrite((dir_ / "r.png").string(), wide(cv::Rect(8, 0, 160, 120)));
+  cv::imwrite((dir_ / "gt.png").string(), cv::Mat(120, 160, CV_8U, cv::Scalar(32)));
+  const Result r = run(
+      "eval --stereo --left l.png --right r.png --gt gt.png --gt-scale 4 --num-disparities 16 "
+      "--matchers bm,fast,fast-census --json s.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(dir_ / "s.json"));
+  ASSERT_EQ(j["stereo"].size(), 3u);
+  for (const auto& row : j["stereo"]) {
+    EXPECT_LT(row["bad1"].get<double>(), 1.0) << row;
+    EXPECT_GT(row["density"].get<double>(), 0.5) << row;
+  }
+}
+
+}  // namespace
