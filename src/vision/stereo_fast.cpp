@@ -89,6 +89,29 @@ void UpdateColumns(D16 d16, const FastJob& j, int add, int sub, std::uint16_t* H
   }
 }
 
+/// Smallest lane. On SSE4 and up: fold to 8 lanes, then PHMINPOSUW (one instruction).
+template <class D16>
+HWY_INLINE std::uint16_t MinLane(D16 d16, hn::Vec<D16> v) {
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_SSE4
+  if constexpr (hn::MaxLanes(d16) >= 8) {
+    if constexpr (hn::MaxLanes(d16) == 32) {
+      const hn::Half<D16> dh;
+      const auto v16 = hn::Min(hn::LowerHalf(dh, v), hn::UpperHalf(dh, v));
+      const hn::Half<decltype(dh)> dq;
+      const auto v8 = hn::Min(hn::LowerHalf(dq, v16), hn::UpperHalf(dq, v16));
+      return static_cast<std::uint16_t>(_mm_extract_epi16(_mm_minpos_epu16(v8.raw), 0));
+    } else if constexpr (hn::MaxLanes(d16) == 16) {
+      const hn::Half<D16> dh;
+      const auto v8 = hn::Min(hn::LowerHalf(dh, v), hn::UpperHalf(dh, v));
+      return static_cast<std::uint16_t>(_mm_extract_epi16(_mm_minpos_epu16(v8.raw), 0));
+    } else {
+      return static_cast<std::uint16_t>(_mm_extract_epi16(_mm_minpos_epu16(v.raw), 0));
+    }
+  }
+#endif
+  return hn::GetLane(hn::MinOfLanes(d16, v));
+}
+
 template <bool kCensus, class D16>
 void MatchRowsT(D16 d16, const FastJob& j) {
   const int n = static_cast<int>(hn::Lanes(d16));
@@ -133,7 +156,7 @@ void MatchRowsT(D16 d16, const FastJob& j) {
       const std::uint16_t* c = s.get() + static_cast<size_t>(i) * nd;
       auto vmin = hn::Load(d16, c);
       for (int d = n; d < nd; d += n) vmin = hn::Min(vmin, hn::Load(d16, c + d));
-      const std::uint16_t m = hn::GetLane(hn::MinOfLanes(d16, vmin));
+      const std::uint16_t m = MinLane(d16, vmin);
       const auto vm = hn::Set(d16, m);
       int b = -1;
       size_t count = 0;  // disparities within the uniqueness threshold
