@@ -1,5 +1,6 @@
 #include "sg/pipeline/stereo_evaluation.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
@@ -52,18 +53,24 @@ std::vector<StereoEvalRow> evaluate_stereo(
       if (params.bm.min_disparity + params.bm.num_disparities >= frame.left.cols)
         problems.push_back(pair.name + ": num_disparities must be below the image width");
       core::throw_if_invalid(problems, "invalid stereo settings for " + m.label);
+      // The best of three runs: the figure least disturbed by other processes.
       cv::Mat disp(frame.left.size(), CV_32F);
-      const auto t0 = std::chrono::steady_clock::now();
-      vision::disparity_rows(frame, params, disp, cv::Range::all());
-      vision::disparity_finish(params, disp);
-      const auto t1 = std::chrono::steady_clock::now();
+      double best_ms = 0;
+      for (int run = 0; run < 3; ++run) {
+        const auto t0 = std::chrono::steady_clock::now();
+        vision::disparity_rows(frame, params, disp, cv::Range::all());
+        vision::disparity_finish(params, disp);
+        const auto t1 = std::chrono::steady_clock::now();
+        const double ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+        best_ms = run == 0 ? ms : std::min(best_ms, ms);
+      }
       StereoEvalRow row;
       row.pair = pair.name;
       row.matcher = m.label;
       row.num_disparities = params.bm.num_disparities;
       row.block_size = params.bm.block_size;
       row.scores = eval::score_disparity(disp, gt);
-      row.ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+      row.ms = best_ms;
       if (on_row) on_row(row);
       rows.push_back(row);
     }

@@ -129,5 +129,18 @@ TEST(Config, BadModeMissingFileAndBadYaml) {
           .empty());
 }
 
+TEST(Config, StereoMatcherAndCost) {
+  ScratchDir dir;
+  core::DetectorParams p;
+  RunSettings s;
+  auto path = write_file(dir, "stereo: {matcher: fast, cost: census}\n");
+  apply_config_file(path, p, s);
+  EXPECT_EQ(p.bm.matcher, core::Matcher::kFast);
+  EXPECT_EQ(p.bm.cost, core::MatchCost::kCensus);
+  path = write_file(dir, "stereo: {matcher: elas}\n");
+  const std::string message = input_error_of([&] { apply_config_file(path, p, s); });
+  EXPECT_NE(message.find("stereo.matcher=elas"), std::string::npos) << message;
+}
+
 }  // namespace
 }  // namespace sg::io

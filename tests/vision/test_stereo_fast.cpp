@@ -113,12 +113,7 @@ TEST(StereoFast, NonContinuousRoiInputsOnEveryTarget) {
   const cv::Mat l = big_l(roi), r = big_r(roi);
   ASSERT_FALSE(l.isContinuous());
   for (core::MatchCost cost : {core::MatchCost::kSad, core::MatchCost::kCensus}) {
-    core::BmParams p;
-    p.matcher = core::Matcher::kFast;
-    p.cost = cost;
-    p.num_disparities = 32;
-    p.block_size = 9;
-    p.lr_max_diff = 1;
+    const core::BmParams p = params_of(Case{"", cost, 0, 32, 9, 15, 10, 1});
     cv::Mat expected;
     match_fast_reference(pair.left, pair.right, p, expected, cv::Range::all());
     expect_all_targets_equal(l, r, p, expected, core::to_string(cost));
@@ -134,12 +129,7 @@ TEST(StereoFast, NonContinuousRoiInputsOnEveryTarget) {
 TEST(StereoFast, StitchedTilesAreBitIdenticalToWholeImage) {
   const auto pair = noisy_scene({257, 190}, 3);
   for (core::MatchCost cost : {core::MatchCost::kSad, core::MatchCost::kCensus}) {
-    core::BmParams p;
-    p.matcher = core::Matcher::kFast;
-    p.cost = cost;
-    p.num_disparities = 32;
-    p.block_size = 11;
-    p.lr_max_diff = 2;
+    const core::BmParams p = params_of(Case{"", cost, 0, 32, 11, 15, 10, 2});
     cv::Mat whole;
     match_fast_rows(pair.left, pair.right, p, whole, cv::Range::all());
     for (int tiles : {2, 3, 7, 190}) {

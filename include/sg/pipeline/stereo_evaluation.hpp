@@ -25,7 +25,7 @@ struct StereoEvalRow {
   std::string pair, matcher;
   int num_disparities = 0, block_size = 0;
   eval::StereoScores scores;
-  double ms = 0;  ///< matching time of the frame (raw match + speckle filter), ms
+  double ms = 0;  ///< matching time (raw match + speckle filter), best of 3 runs, ms
 };
 
 /// Runs every matcher on every pair (images read as gray). When `auto_range`, each pair's
