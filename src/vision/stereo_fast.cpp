@@ -162,16 +162,12 @@ void MatchRowsT(D16 d16, const FastJob& j) {
       size_t count = 0;  // disparities within the uniqueness threshold
       const int thresh = j.uniqueness > 0 ? std::min(m + m * j.uniqueness / 100, 65535) : -1;
       const auto vt = hn::Set(d16, static_cast<std::uint16_t>(std::max(thresh, 0)));
+      // Branch-free over the (few) vectors: which vector holds the winner is unpredictable.
       for (int d = 0; d < nd; d += n) {
         const auto cv = hn::Load(d16, c + d);
-        if (b < 0) {
-          const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(cv, vm));
-          if (f >= 0) b = d + static_cast<int>(f);
-        }
-        if (thresh >= 0)
-          count += hn::CountTrue(d16, hn::Eq(hn::Min(cv, vt), cv));
-        else if (b >= 0)
-          break;
+        const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(cv, vm));
+        b = (b < 0 && f >= 0) ? d + static_cast<int>(f) : b;
+        if (thresh >= 0) count += hn::CountTrue(d16, hn::Eq(hn::Min(cv, vt), cv));
       }
       best[i] = b;
       if (thresh >= 0) {
