@@ -280,15 +280,14 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
 
   cv::Mat pl, pr, cl, cr;
   prefilter_rows(left, p.prefilter_cap, ya, yb, pl);  // SAD cost and texture
-  std::vector<std::uint8_t> l8, r8;
+  std::vector<std::uint8_t> r8;
   std::vector<std::uint16_t> llo, lhi, rlo, rhi;
   if (!job.census) {
     prefilter_rows(right, p.prefilter_cap, ya, yb, pr);
     const auto same = [](std::uint8_t v) { return v; };
-    l8 = plane<std::uint8_t, std::uint8_t>(pl, false, same);
     r8 = plane<std::uint8_t, std::uint8_t>(pr, true, same);
-    job.step8 = static_cast<size_t>(width);
-    job.left8 = l8.data();
+    job.step8 = static_cast<size_t>(width);  // pl is continuous: created above
+    job.left8 = pl.ptr<std::uint8_t>(0);
     job.right8_rev = r8.data();
   } else {
     census_rows(left, ya, yb, cl);

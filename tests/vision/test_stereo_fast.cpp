@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "sg/vision/frame_kernels.hpp"
 #include "sg/vision/stereo_fast.hpp"
+#include "sg/vision/stereo_sgbm.hpp"
 #include "synthetic.hpp"
 
 namespace sg::vision {
@@ -183,6 +185,30 @@ TEST(StereoFast, BordersAndTexturelessAreInvalid) {
   EXPECT_EQ(cv::countNonZero(disp.rowRange(0, 3) != -1.0f), 0);
   EXPECT_EQ(cv::countNonZero(disp.rowRange(57, 60) != -1.0f), 0);
   EXPECT_GT(cv::countNonZero(disp.rowRange(3, 57) >= 0.0f), 0);
+}
+
+TEST(StereoFast, FrameKernelsDispatchOnTheMatcher) {
+  const auto pair = noisy_scene({200, 150}, 9);
+  core::StereoFrame frame;
+  frame.left = pair.left;
+  frame.right = pair.right;
+  core::DetectorParams params;
+  params.bm.num_disparities = 32;
+  for (core::Matcher m : {core::Matcher::kFast, core::Matcher::kSgbm}) {
+    params.bm.matcher = m;
+    cv::Mat direct, whole, tiled(150, 200, CV_32F, cv::Scalar(5.0f));
+    if (m == core::Matcher::kFast)
+      match_fast_rows(pair.left, pair.right, params.bm, direct, cv::Range::all());
+    else
+      match_sgbm_rows(pair.left, pair.right, params.bm, direct, cv::Range::all());
+    disparity_rows(frame, params, whole, cv::Range::all());
+    EXPECT_TRUE(identical(whole, direct)) << core::to_string(m);
+    // Tiles (sgbm: each one from a whole-image match) stitch to the whole image.
+    for (int t = 0; t < 3; ++t)
+      disparity_rows(frame, params, tiled, cv::Range(50 * t, 50 * t + 50));
+    EXPECT_TRUE(identical(tiled, whole)) << core::to_string(m);
+    EXPECT_GT(cv::countNonZero(whole >= 0), 200 * 150 / 4) << core::to_string(m);
+  }
 }
 
 TEST(StereoFast, DispatchesToEachCompiledTarget) {
