@@ -41,6 +41,8 @@ struct FastJob {
   size_t step16 = 0;
   const std::uint8_t* texture_ok = nullptr;  ///< per output row and x: 1 = enough texture
   size_t texture_step = 0;
+  std::uint16_t* v = nullptr;   ///< scratch: column sums, (width - xb) x num_disp, aligned
+  std::uint16_t* s = nullptr;   ///< scratch: block sums of one row, output columns x num_disp
   std::int16_t* out = nullptr;  ///< per output row: disparity * 16 or kInvalid16
   size_t out_step = 0;
 };
@@ -119,28 +121,28 @@ void MatchRowsT(D16 d16, const FastJob& j) {
   const int xb = j.min_disp + nd - 1;       // first column with a full search range
   const int x0 = xb + h, x1 = j.width - h;  // output columns
   const int ncols = j.width - xb, nout = x1 - x0;
-  auto v = hwy::AllocateAligned<std::uint16_t>(static_cast<size_t>(ncols) * nd);
-  auto s = hwy::AllocateAligned<std::uint16_t>(static_cast<size_t>(nout) * nd);
+  std::uint16_t* HWY_RESTRICT v = j.v;
+  std::uint16_t* HWY_RESTRICT s = j.s;
   std::vector<int> best(nout);
-  std::fill(v.get(), v.get() + static_cast<size_t>(ncols) * nd, std::uint16_t{0});
-  for (int row = 0; row < 2 * h + 1; ++row) UpdateColumns<kCensus>(d16, j, row, -1, v.get());
+  std::fill(v, v + static_cast<size_t>(ncols) * nd, std::uint16_t{0});
+  for (int row = 0; row < 2 * h + 1; ++row) UpdateColumns<kCensus>(d16, j, row, -1, v);
 
   for (int y = j.y_begin; y < j.y_end; ++y) {
     const int row = y - (j.y_begin - h);  // input row of y
-    if (y > j.y_begin) UpdateColumns<kCensus>(d16, j, row + h, row - h - 1, v.get());
+    if (y > j.y_begin) UpdateColumns<kCensus>(d16, j, row + h, row - h - 1, v);
     // Horizontal box sums, incremental along x.
-    std::uint16_t* s0 = s.get();
+    std::uint16_t* s0 = s;
     for (int d = 0; d < nd; d += n) {
       auto acc = hn::Zero(d16);
       for (int k = 0; k < 2 * h + 1; ++k)
-        acc = hn::Add(acc, hn::Load(d16, v.get() + static_cast<size_t>(k) * nd + d));
+        acc = hn::Add(acc, hn::Load(d16, v + static_cast<size_t>(k) * nd + d));
       hn::Store(acc, d16, s0 + d);
     }
     for (int i = 1; i < nout; ++i) {
-      const std::uint16_t* add = v.get() + static_cast<size_t>(i + 2 * h) * nd;
-      const std::uint16_t* sub = v.get() + static_cast<size_t>(i - 1) * nd;
-      const std::uint16_t* prev = s.get() + static_cast<size_t>(i - 1) * nd;
-      std::uint16_t* cur = s.get() + static_cast<size_t>(i) * nd;
+      const std::uint16_t* add = v + static_cast<size_t>(i + 2 * h) * nd;
+      const std::uint16_t* sub = v + static_cast<size_t>(i - 1) * nd;
+      const std::uint16_t* prev = s + static_cast<size_t>(i - 1) * nd;
+      std::uint16_t* cur = s + static_cast<size_t>(i) * nd;
       for (int d = 0; d < nd; d += n) {
         const auto sum = hn::Sub(hn::Add(hn::Load(d16, prev + d), hn::Load(d16, add + d)),
                                  hn::Load(d16, sub + d));
@@ -153,7 +155,7 @@ void MatchRowsT(D16 d16, const FastJob& j) {
     for (int i = 0; i < nout; ++i) {
       out[x0 + i] = kInvalid16;
       if (!tex[x0 + i]) continue;
-      const std::uint16_t* c = s.get() + static_cast<size_t>(i) * nd;
+      const std::uint16_t* c = s + static_cast<size_t>(i) * nd;
       auto vmin = hn::Load(d16, c);
       for (int d = n; d < nd; d += n) vmin = hn::Min(vmin, hn::Load(d16, c + d));
       const std::uint16_t m = MinLane(d16, vmin);
@@ -183,7 +185,7 @@ void MatchRowsT(D16 d16, const FastJob& j) {
       // Right image's winners: right pixel xr is seen by left pixel xr + min_disp + d at d.
       std::vector<int> rbest(j.width, -1), rcost(j.width, INT_MAX);
       for (int i = 0; i < nout; ++i) {
-        const std::uint16_t* c = s.get() + static_cast<size_t>(i) * nd;
+        const std::uint16_t* c = s + static_cast<size_t>(i) * nd;
         const int x = x0 + i;
         for (int d = 0; d < nd; ++d) {
           const int xr = x - j.min_disp - d;
@@ -234,18 +236,35 @@ HWY_EXPORT(MatchRows);
 HWY_EXPORT(CurrentTarget);
 
 namespace {
-/// Copies each row of `rows` (elements of type T) through `f` into a continuous buffer, reversed
-/// when `reverse`.
+/// Copies each row of `rows` (elements of type T) through `f` into the continuous buffer `out`,
+/// reversed when `reverse`.
 template <typename Out, typename T, typename F>
-std::vector<Out> plane(const cv::Mat& rows, bool reverse, F f) {
+void plane(const cv::Mat& rows, bool reverse, F f, std::vector<Out>& out) {
   const int w = rows.cols;
-  std::vector<Out> out(static_cast<size_t>(rows.rows) * w);
+  out.resize(static_cast<size_t>(rows.rows) * w);
   for (int y = 0; y < rows.rows; ++y) {
     const T* src = rows.ptr<T>(y);
     Out* dst = out.data() + static_cast<size_t>(y) * w;
     for (int x = 0; x < w; ++x) dst[reverse ? w - 1 - x : x] = f(src[x]);
   }
-  return out;
+}
+
+/// Buffers reused across calls on one thread: allocating megabytes per frame costs page faults.
+/// They hold no state that reaches the output.
+struct Scratch {
+  cv::Mat pl, pr, cl, cr, integral, tex_ok, out16;
+  std::vector<std::uint8_t> r8;
+  std::vector<std::uint16_t> llo, lhi, rlo, rhi;
+  hwy::AlignedFreeUniquePtr<std::uint16_t[]> v, s;
+  size_t v_size = 0, s_size = 0;
+};
+
+std::uint16_t* aligned(hwy::AlignedFreeUniquePtr<std::uint16_t[]>& p, size_t& size, size_t need) {
+  if (size < need) {
+    p = hwy::AllocateAligned<std::uint16_t>(need);
+    size = need;
+  }
+  return p.get();
 }
 }  // namespace
 }  // namespace fast_detail
@@ -278,46 +297,51 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
   job.y_begin = y0;
   job.y_end = y1;
 
-  cv::Mat pl, pr, cl, cr;
+  thread_local Scratch scratch;
+  Scratch& sc = scratch;
+  cv::Mat &pl = sc.pl, &pr = sc.pr, &cl = sc.cl, &cr = sc.cr;
   prefilter_rows(left, p.prefilter_cap, ya, yb, pl);  // SAD cost and texture
-  std::vector<std::uint8_t> r8;
-  std::vector<std::uint16_t> llo, lhi, rlo, rhi;
   if (!job.census) {
     prefilter_rows(right, p.prefilter_cap, ya, yb, pr);
     const auto same = [](std::uint8_t v) { return v; };
-    r8 = plane<std::uint8_t, std::uint8_t>(pr, true, same);
+    plane<std::uint8_t, std::uint8_t>(pr, true, same, sc.r8);
     job.step8 = static_cast<size_t>(width);  // pl is continuous: created above
     job.left8 = pl.ptr<std::uint8_t>(0);
-    job.right8_rev = r8.data();
+    job.right8_rev = sc.r8.data();
   } else {
     census_rows(left, ya, yb, cl);
     census_rows(right, ya, yb, cr);
     const auto lo = [](int v) { return static_cast<std::uint16_t>(v & 0xFFFF); };
     const auto hi = [](int v) { return static_cast<std::uint16_t>(v >> 16); };
-    llo = plane<std::uint16_t, int>(cl, false, lo);
-    lhi = plane<std::uint16_t, int>(cl, false, hi);
-    rlo = plane<std::uint16_t, int>(cr, true, lo);
-    rhi = plane<std::uint16_t, int>(cr, true, hi);
+    plane<std::uint16_t, int>(cl, false, lo, sc.llo);
+    plane<std::uint16_t, int>(cl, false, hi, sc.lhi);
+    plane<std::uint16_t, int>(cr, true, lo, sc.rlo);
+    plane<std::uint16_t, int>(cr, true, hi, sc.rhi);
     job.step16 = static_cast<size_t>(width);
-    job.left_lo = llo.data();
-    job.left_hi = lhi.data();
-    job.right_lo_rev = rlo.data();
-    job.right_hi_rev = rhi.data();
+    job.left_lo = sc.llo.data();
+    job.left_hi = sc.lhi.data();
+    job.right_lo_rev = sc.rlo.data();
+    job.right_hi_rev = sc.rhi.data();
   }
 
   // Texture: block sums of |prefiltered - cap| from an integral image (exact integers).
-  cv::Mat integral(pl.rows + 1, width + 1, CV_32S, cv::Scalar(0));
+  cv::Mat& integral = sc.integral;
+  integral.create(pl.rows + 1, width + 1, CV_32S);
+  integral.row(0).setTo(0);
   for (int y = 0; y < pl.rows; ++y) {
     const std::uint8_t* src = pl.ptr<std::uint8_t>(y);
     const int* above = integral.ptr<int>(y);
     int* dst = integral.ptr<int>(y + 1);
+    dst[0] = 0;
     int row_sum = 0;
     for (int x = 0; x < width; ++x) {
       row_sum += std::abs(src[x] - p.prefilter_cap);
       dst[x + 1] = above[x + 1] + row_sum;
     }
   }
-  cv::Mat tex_ok(y1 - y0, width, CV_8U, cv::Scalar(0));
+  cv::Mat& tex_ok = sc.tex_ok;
+  tex_ok.create(y1 - y0, width, CV_8U);
+  tex_ok.setTo(0);
   const int b = 2 * h + 1;
   for (int y = y0; y < y1; ++y) {
     const int* top = integral.ptr<int>(y - h - ya);
@@ -331,7 +355,12 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
   job.texture_ok = tex_ok.ptr<std::uint8_t>(0);
   job.texture_step = tex_ok.step1();
 
-  cv::Mat out16(y1 - y0, width, CV_16S, cv::Scalar(kInvalid16));
+  cv::Mat& out16 = sc.out16;
+  out16.create(y1 - y0, width, CV_16S);
+  out16.setTo(kInvalid16);
+  const int xb = md + nd - 1;
+  job.v = aligned(sc.v, sc.v_size, static_cast<size_t>(width - xb) * nd);
+  job.s = aligned(sc.s, sc.s_size, static_cast<size_t>(width - h - (xb + h)) * nd);
   job.out = out16.ptr<std::int16_t>(0);
   job.out_step = out16.step1();
   HWY_DYNAMIC_DISPATCH(MatchRows)(job);
