@@ -6,15 +6,54 @@
 
 namespace sg::apps {
 
-void add_input_options(CLI::App& app, InputOptions& options) {
+void add_input_options(CLI::App& app, InputOptions& options, bool left_right) {
   auto* scenario = app.add_option("--scenario", options.scenario,
                                   "built-in scenario name or scenario YAML file");
   auto* input = app.add_option("--input", options.input, "stereo folder (see README)");
   scenario->excludes(input);
+  io::SourceSpec& s = options.spec;
+  if (left_right) {
+    app.add_option("--left", s.left, "left video, image folder or glob pattern ('dir/l*.png')");
+    app.add_option("--right", s.right, "right video, image folder or glob pattern");
+  }
+  app.add_option("--sbs", options.sbs,
+                 "side-by-side video (left half = left image); alone with one --camera: a "
+                 "side-by-side camera")
+      ->expected(0, 1);
+  app.add_option("--kitti", s.kitti, "KITTI raw drive folder (image_00, image_01, timestamps)");
+  app.add_flag("--kitti-color", s.kitti_color, "with --kitti: colour cameras image_02/image_03");
+  app.add_option("--euroc", s.euroc, "EuRoC mav0 folder (cam0, cam1, sensor.yaml, data.csv)");
+  app.add_option("--camera", s.camera, "V4L2 camera indices I,J (or I with --sbs)")
+      ->delimiter(',');
+  app.add_option("--calib", s.calib,
+                 "calibration: OpenCV YAML/XML (M1 D1 M2 D2 R T [R1 R2 P1 P2 Q]), KITTI "
+                 "calib_cam_to_cam.txt, or a camera.yaml of a rectified pair");
+  app.add_option("--focal", s.focal_px, "rectified input: focal length, px");
+  app.add_option("--baseline", s.baseline_m, "rectified input: baseline, m");
+  app.add_option("--cx", s.cx, "rectified input: principal point x, px (default: image centre)");
+  app.add_option("--cy", s.cy, "rectified input: principal point y, px (default: image centre)");
+  app.add_option("--input-fps", s.input_fps,
+                 "frame rate of an input without timestamps or a stated rate, Hz (default 30)");
 }
 
-OpenedInput open_input(const InputOptions& options) {
+OpenedInput open_input(const InputOptions& options_in) {
+  InputOptions options = options_in;
+  if (options.sbs) {
+    if (options.sbs->empty()) {
+      options.spec.sbs_camera = true;
+    } else {
+      options.spec.sbs = *options.sbs;
+    }
+  }
   OpenedInput opened;
+  if (options.spec.any()) {
+    if (!options.input.empty() || !options.scenario.empty()) {
+      throw core::InputError("give one input: --scenario, --input or " + options.spec.name());
+    }
+    opened.name = options.spec.name();
+    opened.source = io::open_source(options.spec);
+    return opened;
+  }
   if (!options.input.empty()) {
     opened.name = options.input;
     auto source = std::make_unique<io::FolderSource>(options.input);

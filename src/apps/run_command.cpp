@@ -17,7 +17,8 @@ namespace sg::apps {
 namespace {
 
 struct RunArgs {
-  InputOptions input{.scenario = {}, .input = {}, .fallback_scenario = "head-on"};
+  InputOptions input{.scenario = {}, .input = {}, .spec = {}, .sbs = {},
+                     .fallback_scenario = "head-on"};
   DetectorOptions detector;
   std::string events, overlay, summary;
   bool no_timing = false;
