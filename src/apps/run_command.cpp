@@ -69,7 +69,8 @@ void run_main(const RunArgs& args) {
   core::throw_if_invalid(pipeline::validate(options, cam), "invalid parameters");
 
   std::string overlay = args.overlay;
-  if (overlay.empty() && args.input.input.empty() && args.input.scenario.empty()) {
+  if (overlay.empty() && args.input.input.empty() && args.input.scenario.empty() &&
+      !args.input.spec.any() && !args.input.sbs) {
     overlay = "stereoguard-" + in.name + ".mp4";
   }
   std::optional<io::EventWriter> events;

@@ -359,14 +359,19 @@ Calibration read_calibration(const fs::path& path, bool kitti_color) {
         kitti_color ? read_kitti_calibration(path, 2, 3) : read_kitti_calibration(path, 0, 1);
     return out;
   }
-  cv::FileStorage file = open_storage(path);
-  if (!file["focal_px"].empty()) {
-    file.release();
-    // A stereoguard camera.yaml: size comes from the images later.
-    out.rectified = read_camera_yaml(path, cv::Size(1, 1));
-    return out;
+  if (ext != ".xml" && ext != ".gz") {
+    // stereoguard's camera.yaml is plain YAML, which OpenCV's reader may refuse.
+    YAML::Node root;
+    try {
+      root = load_yaml(path);
+    } catch (const core::InputError&) {
+      root = YAML::Node();
+    }
+    if (root.IsMap() && root["focal_px"]) {
+      out.rectified = read_camera_yaml(path, cv::Size(1, 1));  // size comes from the images
+      return out;
+    }
   }
-  file.release();
   out.stereo = read_opencv_calibration(path);
   return out;
 }

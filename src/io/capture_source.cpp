@@ -1,3 +1,4 @@
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <opencv2/imgproc.hpp>
@@ -10,6 +11,9 @@ namespace sg::io {
 namespace {
 
 cv::VideoCapture open_file(const std::string& path) {
+  // FFmpeg's own log lines would break the one-line error a user gets for a broken video; the
+  // errors are reported by us. A user's OPENCV_FFMPEG_LOGLEVEL wins (setenv does not overwrite).
+  ::setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
     throw core::InputError("video not found: " + path);
