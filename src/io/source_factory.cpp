@@ -71,15 +71,15 @@ CameraPlan plan_camera(const SourceSpec& spec) {
 }
 
 /// Sets the frame rate of a stream without timestamps: --input-fps, else the calibration's, else
-/// an assumed 30 Hz with a warning.
-void set_nominal_fps(CameraPlan& plan, const SourceSpec& spec) {
+/// an assumed 30 Hz. Returns true when assumed (the caller warns once the input has opened).
+bool set_nominal_fps(CameraPlan& plan, const SourceSpec& spec) {
   if (spec.input_fps) {
     plan.camera.fps = *spec.input_fps;
   } else if (!plan.fps_known) {
-    std::cerr << "stereoguard: warning: " << spec.name() << " states no frame rate; assuming "
-              << kAssumedFps << " Hz (give --input-fps)\n";
     plan.camera.fps = kAssumedFps;
+    return true;
   }
+  return false;
 }
 
 /// The sources take the camera as planned; a principal point left open becomes the image centre
@@ -138,6 +138,7 @@ std::unique_ptr<core::FrameSource> open_source(const SourceSpec& spec) {
   }
   CameraPlan plan = plan_camera(spec);
   std::unique_ptr<core::FrameSource> source;
+  bool fps_assumed = false;
   if (!spec.camera.empty()) {
     if (spec.camera.size() > 2 || (spec.camera.size() == 1) != spec.sbs_camera) {
       throw core::InputError("--camera takes two indices I,J, or one index with --sbs");
@@ -161,7 +162,7 @@ std::unique_ptr<core::FrameSource> open_source(const SourceSpec& spec) {
       plan.camera.fps = spec.input_fps.value_or(plan.fps_known ? plan.camera.fps : kAssumedFps);
       source = CaptureSource::open_videos(spec.left, spec.right, plan.camera);
     } else {
-      set_nominal_fps(plan, spec);
+      fps_assumed = set_nominal_fps(plan, spec);
       const auto l = list_images(spec.left), r = list_images(spec.right);
       const size_t n = shorter_count(l.size(), r.size(), spec.left, spec.right);
       std::vector<ImagePair> pairs(n);
@@ -171,6 +172,10 @@ std::unique_ptr<core::FrameSource> open_source(const SourceSpec& spec) {
   }
   source = finish(std::move(source), plan, spec);
   core::throw_if_invalid(core::validate(source->camera()), "invalid camera for " + spec.name());
+  if (fps_assumed) {
+    std::cerr << "stereoguard: warning: " << spec.name() << " states no frame rate; assuming "
+              << kAssumedFps << " Hz (give --input-fps)\n";
+  }
   return source;
 }
 
