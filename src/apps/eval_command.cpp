@@ -173,7 +173,7 @@ void eval_main(const EvalArgs& args) {
   InputOptions input = args.input;
   input.spec.left = args.left;  // --left/--right are shared with --flow
   input.spec.right = args.right;
-  OpenedInput in = open_input(input);
+  OpenedInput in = open_input(input, args.detector.config);
   pipeline::TruthLookup truth_of;
   if (in.scenario) {
     truth_of = [s = in.scenario](int) {

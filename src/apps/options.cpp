@@ -23,8 +23,7 @@ void add_input_options(CLI::App& app, InputOptions& options, bool left_right) {
   app.add_option("--kitti", s.kitti, "KITTI raw drive folder (image_00, image_01, timestamps)");
   app.add_flag("--kitti-color", s.kitti_color, "with --kitti: colour cameras image_02/image_03");
   app.add_option("--euroc", s.euroc, "EuRoC mav0 folder (cam0, cam1, sensor.yaml, data.csv)");
-  app.add_option("--camera", s.camera, "V4L2 camera indices I,J (or I with --sbs)")
-      ->delimiter(',');
+  app.add_option("--camera", s.camera, "V4L2 camera indices I,J (or I with --sbs)")->delimiter(',');
   app.add_option("--calib", s.calib,
                  "calibration: OpenCV YAML/XML (M1 D1 M2 D2 R T [R1 R2 P1 P2 Q]), KITTI "
                  "calib_cam_to_cam.txt, or a camera.yaml of a rectified pair");
@@ -36,14 +35,40 @@ void add_input_options(CLI::App& app, InputOptions& options, bool left_right) {
                  "frame rate of an input without timestamps or a stated rate, Hz (default 30)");
 }
 
-OpenedInput open_input(const InputOptions& options_in) {
+OpenedInput open_input(const InputOptions& options_in, const std::string& config) {
   InputOptions options = options_in;
-  if (options.sbs) {
+  if (options.sbs) {  // --sbs alone: a side-by-side camera
     if (options.sbs->empty()) {
       options.spec.sbs_camera = true;
     } else {
       options.spec.sbs = *options.sbs;
     }
+  }
+  const bool flags =
+      options.spec.any() || options.sbs || !options.input.empty() || !options.scenario.empty();
+  if (!config.empty()) {
+    core::DetectorParams unused;
+    io::RunSettings settings;
+    io::apply_config_file(config, unused, settings);
+    // The input the flags name, else the config's; its camera from the config, flags on top.
+    const io::SourceSpec& c = settings.input;
+    io::SourceSpec merged = flags ? options.spec : c;
+    merged.calib = c.calib;
+    merged.focal_px = c.focal_px;
+    merged.baseline_m = c.baseline_m;
+    merged.cx = c.cx;
+    merged.cy = c.cy;
+    merged.input_fps = c.input_fps;
+    const io::SourceSpec& f = options.spec;
+    if (!f.calib.empty()) merged.calib = f.calib;
+    for (auto [to, from] : {std::pair{&merged.focal_px, &f.focal_px},
+                            {&merged.baseline_m, &f.baseline_m},
+                            {&merged.cx, &f.cx},
+                            {&merged.cy, &f.cy},
+                            {&merged.input_fps, &f.input_fps}}) {
+      if (*from) *to = *from;
+    }
+    options.spec = merged;
   }
   OpenedInput opened;
   if (options.spec.any()) {
@@ -85,7 +110,8 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                  "farneback");
   app.add_option("--min-area", o.min_area, "smallest obstacle blob, px (default 150)");
   app.add_option("--fps", o.fps, "pace the input like a camera at this rate, Hz (0 = no pacing)");
-  app.add_option("--workers", o.workers, "W: farm workers computing SM/OF tasks at once (default 1)");
+  app.add_option("--workers", o.workers,
+                 "W: farm workers computing SM/OF tasks at once (default 1)");
   app.add_option("--tiles", o.tiles, "T: row tiles per task (default 1)");
   app.add_option("--tokens", o.tokens, "frames in flight (default 0 = W + 1)");
   app.add_option("--threads", o.threads, "threads of the task arena (default 0 = all cores)");

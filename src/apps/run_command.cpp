@@ -64,7 +64,7 @@ class WarningPrinter {
 
 void run_main(const RunArgs& args) {
   const pipeline::RunOptions options = make_run_options(args.detector);
-  OpenedInput in = open_input(args.input);
+  OpenedInput in = open_input(args.input, args.detector.config);
   const core::Camera& cam = in.source->camera();
   core::throw_if_invalid(pipeline::validate(options, cam), "invalid parameters");
 

@@ -108,6 +108,12 @@ TEST_F(Inputs, TwoLosslessVideosGiveTheEventsOfTheFolder) {
          "--no-timing --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   expect_same_events_as_folder("v.jsonl");
+  // The same input from the config file's input: section.
+  std::ofstream(dir_ / "c.yaml") << "input: {left: l.mkv, right: r.mkv, calib: fold/camera.yaml}\n";
+  ASSERT_EQ(sg("run --config c.yaml --events c.jsonl --no-timing --quiet").status, 0);
+  expect_same_events_as_folder("c.jsonl");
+  std::ofstream(dir_ / "bad.yaml") << "input: {left: l.mkv, rigth: r.mkv}\n";
+  expect_user_error(sg("run --config bad.yaml"), "input.rigth is not a known setting");
 }
 
 TEST_F(Inputs, SideBySideLosslessVideoGivesTheEventsOfTheFolder) {
