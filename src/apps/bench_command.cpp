@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "sg/core/error.hpp"
 #include "sg/pipeline/bench.hpp"
 
@@ -25,15 +26,6 @@ struct BenchArgs {
   std::string csv = "stereoguard-bench.csv";
   std::string plot;
 };
-
-cv::Size parse_resolution(const std::string& text) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x') {
-    throw core::InputError("resolution=" + text + ": must look like 640x480");
-  }
-  return {w, h};
-}
 
 void print_row(const pipeline::BenchRow& r) {
   std::cout << std::left << std::setw(9) << r.kind << std::setw(12) << r.mode << std::right
@@ -79,7 +71,7 @@ void bench_main(const BenchArgs& a) {
   config.workers = a.workers;
   config.tiles = a.tiles;
   config.resolutions.clear();
-  for (const auto& r : a.resolutions) config.resolutions.push_back(parse_resolution(r));
+  for (const auto& r : a.resolutions) config.resolutions.push_back(parse_size(r, "resolution", "640x480"));
   config.frames = a.frames;
   config.num_disparities = a.num_disparities;
   config.threads = a.threads;

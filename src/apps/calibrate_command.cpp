@@ -1,10 +1,10 @@
 // `stereoguard calibrate`: stereo calibration from chessboard pairs, written as OpenCV YAML that
 // `run --calib` reads.
-#include <cstdio>
 #include <iomanip>
 #include <iostream>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "sg/core/error.hpp"
 #include "sg/io/calibration.hpp"
 #include "sg/io/sources.hpp"
@@ -17,18 +17,9 @@ struct CalibrateArgs {
   double square_m = 0.025;
 };
 
-cv::Size parse_board(const std::string& text) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x') {
-    throw core::InputError("board=" + text + ": must look like 9x6 (inner corners)");
-  }
-  return {w, h};
-}
-
 void calibrate_main(const CalibrateArgs& a) {
   io::ChessboardParams params;
-  params.board = parse_board(a.board);
+  params.board = parse_size(a.board, "board", "9x6 (inner corners)");
   params.square_m = a.square_m;
   core::throw_if_invalid(io::validate(params), "invalid calibrate options");
   const auto left = io::list_images(a.left), right = io::list_images(a.right);

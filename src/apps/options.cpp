@@ -1,5 +1,7 @@
 #include "options.hpp"
 
+#include <cstdio>
+
 #include "sg/core/error.hpp"
 #include "sg/io/config.hpp"
 #include "sg/io/stereo_folder.hpp"
@@ -93,6 +95,15 @@ OpenedInput open_input(const InputOptions& options_in, const std::string& config
   opened.scenario = source.get();
   opened.source = std::move(source);
   return opened;
+}
+
+cv::Size parse_size(const std::string& text, const std::string& name, const std::string& example) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x') {
+    throw core::InputError(name + "=" + text + ": must look like " + example);
+  }
+  return {w, h};
 }
 
 void add_detector_options(CLI::App& app, DetectorOptions& o) {

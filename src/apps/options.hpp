@@ -39,6 +39,9 @@ void add_input_options(CLI::App& app, InputOptions& options, bool left_right = t
 /// no input flag is given.
 OpenedInput open_input(const InputOptions& options, const std::string& config = {});
 
+/// "WxH" as a size; InputError "<name>=<text>: must look like <example>" otherwise.
+cv::Size parse_size(const std::string& text, const std::string& name, const std::string& example);
+
 /// Detector flags (--config, --mode, --num-disparities, --block-size, --gaps, --fps, ...).
 struct DetectorOptions {
   std::string config;

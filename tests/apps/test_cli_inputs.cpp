@@ -12,6 +12,8 @@
 #include <sstream>
 #include <string>
 
+#include "../io/calibration_text.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -271,32 +273,19 @@ TEST_F(Inputs, ImageFoldersOfDifferentCountsStopAtTheShorterWithOneWarning) {
   EXPECT_EQ(valid_event_lines("e.jsonl"), 5);
 }
 
-/// An OpenCV calibration whose M1 is `m1` (empty: no M1).
-void write_calibration(const fs::path& p, const std::string& m1) {
-  std::ofstream out(p);
-  auto mat = [&out](const char* name, int rows, int cols, const std::string& data) {
-    out << name << ": !!opencv-matrix\n  rows: " << rows << "\n  cols: " << cols
-        << "\n  dt: d\n  data: [" << data << "]\n";
-  };
-  out << "%YAML:1.0\n---\n";
-  if (!m1.empty()) mat("M1", 3, 3, m1);
-  mat("D1", 1, 5, "0, 0, 0, 0, 0");
-  mat("M2", 3, 3, "250, 0, 160, 0, 250, 120, 0, 0, 1");
-  mat("D2", 1, 5, "0, 0, 0, 0, 0");
-  mat("R", 3, 3, "1, 0, 0, 0, 1, 0, 0, 0, 1");
-  mat("T", 3, 1, "-0.12, 0, 0");
-}
-
 TEST_F(Inputs, CalibrationWithAMissingFieldANanOrASingularMatrix) {
   make_folder(2);
   const std::string input = "run --left fold/left --right fold/right --calib c.yaml";
-  write_calibration(dir_ / "c.yaml", "");
+  sg::io::testing_util::write_calibration_text(dir_ / "c.yaml", "");
   expect_user_error(sg(input), "c.yaml: missing field 'M1'");
-  write_calibration(dir_ / "c.yaml", "250, 0, .nan, 0, 250, 120, 0, 0, 1");
+  sg::io::testing_util::write_calibration_text(dir_ / "c.yaml",
+                                               "250, 0, .nan, 0, 250, 120, 0, 0, 1");
   expect_user_error(sg(input), "calib.M1: has a value that is not finite");
-  write_calibration(dir_ / "c.yaml", "250, 0, 160, 250, 0, 120, 0, 0, 1");
+  sg::io::testing_util::write_calibration_text(dir_ / "c.yaml",
+                                               "250, 0, 160, 250, 0, 120, 0, 0, 1");
   expect_user_error(sg(input), "calib.M1: not an invertible camera matrix");
-  write_calibration(dir_ / "c.yaml", "250, 0, 160, 0, 250, 120, 0, 0, 1");
+  sg::io::testing_util::write_calibration_text(dir_ / "c.yaml",
+                                               "250, 0, 160, 0, 250, 120, 0, 0, 1");
   EXPECT_EQ(sg(input + " --input-fps 25 --quiet").status, 0);
   std::ofstream(dir_ / "calib_cam_to_cam.txt") << "P_rect_00: 250 0 160 0 0 250 nan 0 0 0 1 0\n";
   expect_user_error(sg("run --left fold/left --right fold/right --calib calib_cam_to_cam.txt"),

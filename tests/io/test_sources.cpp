@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "calibration_text.hpp"
 #include "io_test_util.hpp"
 #include "sg/io/calibration.hpp"
 #include "sg/io/source_factory.hpp"
@@ -22,6 +23,11 @@ namespace {
 namespace fs = std::filesystem;
 using testing_util::input_error_of;
 using testing_util::ScratchDir;
+
+fs::path calibration_file(const fs::path& dir, const std::string& m1) {
+  testing_util::write_calibration_text(dir / "bad.yaml", m1);
+  return dir / "bad.yaml";
+}
 
 cv::Mat random_image(cv::Size size, int seed) {
   cv::Mat m(size, CV_8UC1);
@@ -254,24 +260,6 @@ TEST(OpenCvCalibration, WriteReadRoundTrip) {
   EXPECT_FALSE(any.rectified.has_value());
 }
 
-/// An OpenCV YAML calibration with one field replaced by `m1` (empty: left out).
-fs::path calibration_file(const fs::path& dir, const std::string& m1) {
-  const fs::path p = dir / "bad.yaml";
-  std::ofstream out(p);
-  auto mat = [&out](const char* name, int rows, int cols, const std::string& data) {
-    out << name << ": !!opencv-matrix\n  rows: " << rows << "\n  cols: " << cols
-        << "\n  dt: d\n  data: [" << data << "]\n";
-  };
-  out << "%YAML:1.0\n---\n";
-  if (!m1.empty()) mat("M1", 3, 3, m1);
-  mat("D1", 1, 5, "0, 0, 0, 0, 0");
-  mat("M2", 3, 3, "500, 0, 320, 0, 500, 240, 0, 0, 1");
-  mat("D2", 1, 5, "0, 0, 0, 0, 0");
-  mat("R", 3, 3, "1, 0, 0, 0, 1, 0, 0, 0, 1");
-  mat("T", 3, 1, "-0.12, 0, 0");
-  return p;
-}
-
 TEST(OpenCvCalibration, MissingFieldNanAndSingularMatrixAreNamed) {
   ScratchDir dir;
   EXPECT_NE(input_error_of([&] {
@@ -280,16 +268,16 @@ TEST(OpenCvCalibration, MissingFieldNanAndSingularMatrixAreNamed) {
             std::string::npos);
   EXPECT_NE(
       input_error_of([&] {
-        read_opencv_calibration(calibration_file(dir.path(), "500, 0, .nan, 0, 500, 240, 0, 0, 1"));
+        read_opencv_calibration(calibration_file(dir.path(), "250, 0, .nan, 0, 250, 120, 0, 0, 1"));
       }).find("calib.M1: has a value that is not finite"),
       std::string::npos);
   EXPECT_NE(
       input_error_of([&] {
-        read_opencv_calibration(calibration_file(dir.path(), "500, 0, 320, 500, 0, 240, 0, 0, 1"));
+        read_opencv_calibration(calibration_file(dir.path(), "250, 0, 160, 250, 0, 120, 0, 0, 1"));
       }).find("calib.M1: not an invertible camera matrix"),
       std::string::npos);
   const StereoCalibration good =
-      read_opencv_calibration(calibration_file(dir.path(), "500, 0, 320, 0, 500, 240, 0, 0, 1"));
+      read_opencv_calibration(calibration_file(dir.path(), "250, 0, 160, 0, 250, 120, 0, 0, 1"));
   EXPECT_EQ(good.image_size, cv::Size(0, 0));
 }
 
