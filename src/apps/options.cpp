@@ -13,6 +13,10 @@ void add_input_options(CLI::App& app, InputOptions& options, bool left_right) {
                                   "built-in scenario name or scenario YAML file");
   auto* input = app.add_option("--input", options.input, "stereo folder (see README)");
   scenario->excludes(input);
+  add_source_options(app, options, left_right);
+}
+
+void add_source_options(CLI::App& app, InputOptions& options, bool left_right) {
   io::SourceSpec& s = options.spec;
   if (left_right) {
     app.add_option("--left", s.left, "left video, image folder or glob pattern ('dir/l*.png')");

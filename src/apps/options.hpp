@@ -35,6 +35,8 @@ struct OpenedInput {
 
 /// `left_right`: add --left/--right too (eval has its own for --flow and copies them over).
 void add_input_options(CLI::App& app, InputOptions& options, bool left_right = true);
+/// Only the real-input flags (--left/--right, --sbs, --kitti, --euroc, --camera, --calib, ...).
+void add_source_options(CLI::App& app, InputOptions& options, bool left_right = true);
 /// Opens the input; `config` (a --config file, may be empty) supplies its `input:` section when
 /// no input flag is given.
 OpenedInput open_input(const InputOptions& options, const std::string& config = {});

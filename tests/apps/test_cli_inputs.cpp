@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "../io/calibration_text.hpp"
 
@@ -207,6 +208,24 @@ TEST_F(Inputs, EurocRunWritesOneEventPerPair) {
   std::string line, last;
   while (std::getline(in, line)) last = line;
   EXPECT_NEAR(nlohmann::json::parse(last)["time_s"].get<double>(), 4.70, 0.001);
+}
+
+TEST_F(Inputs, BenchOnARealInputUsesItsFramesAndResolution) {
+  make_folder(6);
+  const Output r =
+      sg("bench --left fold/left --right fold/right --calib fold/camera.yaml --modes "
+         "stereo --workers 1,2 --tiles 1 --frames 14 --pace 2 --csv b.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("input fold/left + fold/right"), std::string::npos) << r.out;
+  std::ifstream csv(dir_ / "b.csv");
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(csv, line);) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 6u) << r.out;  // header, baseline, opencv-mt, W 1, W 2, paced
+  for (size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_NE(rows[i].find(",stereo,321,241,"), std::string::npos) << rows[i];
+  }
+  EXPECT_EQ(rows[3].substr(rows[3].rfind(',') + 1), "yes") << rows[3];
+  EXPECT_EQ(rows[4].substr(rows[4].rfind(',') + 1), "yes") << rows[4];
 }
 
 // ---------------------------------------------------------------------------------------------
