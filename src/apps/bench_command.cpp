@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "sg/core/error.hpp"
 #include "sg/pipeline/bench.hpp"
 
@@ -25,16 +26,8 @@ struct BenchArgs {
   std::string scenario = "head-on";
   std::string csv = "stereoguard-bench.csv";
   std::string plot;
+  InputOptions input;  ///< a real input instead of the scenario (--left/--right, --euroc, ...)
 };
-
-cv::Size parse_resolution(const std::string& text) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x') {
-    throw core::InputError("resolution=" + text + ": must look like 640x480");
-  }
-  return {w, h};
-}
 
 void print_row(const pipeline::BenchRow& r) {
   std::cout << std::left << std::setw(9) << r.kind << std::setw(12) << r.mode << std::right
@@ -80,7 +73,8 @@ void bench_main(const BenchArgs& a) {
   config.workers = a.workers;
   config.tiles = a.tiles;
   config.resolutions.clear();
-  for (const auto& r : a.resolutions) config.resolutions.push_back(parse_resolution(r));
+  for (const auto& r : a.resolutions)
+    config.resolutions.push_back(parse_size(r, "resolution", "640x480"));
   config.frames = a.frames;
   config.num_disparities = a.num_disparities;
   config.matcher = core::parse_matcher(a.matcher);
@@ -88,13 +82,18 @@ void bench_main(const BenchArgs& a) {
   config.threads = a.threads;
   config.scenario = a.scenario;
   config.pace_fractions = a.pace;
+  if (a.input.spec.any() || a.input.sbs) {
+    config.open_input = [input = a.input] { return open_input(input).source; };
+  }
   core::throw_if_invalid(pipeline::validate(config), "invalid bench settings");
 
   std::ofstream csv(a.csv);
   if (!csv) throw core::InputError("cannot write " + a.csv);
   csv << pipeline::bench_csv_header() << "\n";
-  std::cout << "stereoguard bench: scenario " << a.scenario << ", " << a.frames
-            << " frames per configuration, rendered once and held in memory\n"
+  const std::string what = config.open_input ? "input " + a.input.spec.name() + " (read once)"
+                                             : "scenario " + a.scenario + " (rendered once)";
+  std::cout << "stereoguard bench: " << what << ", " << a.frames
+            << " frames per configuration held in memory\n"
             << "kind     mode          resolution  W   T tok  pace/s     fps speedup"
                "     p50     p99   drop  same\n";
   pipeline::run_bench(config, [&](const pipeline::BenchRow& row) {
@@ -131,6 +130,7 @@ void add_bench_command(CLI::App& app) {
                   "also pace the best configuration at these fractions of its capacity "
                   "(first resolution; default 0.8,1.5)")
       ->delimiter(',');
+  add_source_options(*cmd, a->input);
   cmd->add_option("--csv", a->csv, "CSV output (default stereoguard-bench.csv)");
   cmd->add_option("--plot", a->plot, "draw throughput and latency to this PNG (needs gnuplot)");
   cmd->callback([a] { bench_main(*a); });

@@ -9,5 +9,6 @@ void add_simulate_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_scenarios_command(CLI::App& app);
+void add_calibrate_command(CLI::App& app);
 
 }  // namespace sg::apps

@@ -189,7 +189,10 @@ void eval_main(const EvalArgs& args) {
     return;
   }
   const pipeline::RunOptions options = make_run_options(args.detector);
-  OpenedInput in = open_input(args.input);
+  InputOptions input = args.input;
+  input.spec.left = args.left;  // --left/--right are shared with --flow
+  input.spec.right = args.right;
+  OpenedInput in = open_input(input, args.detector.config);
   pipeline::TruthLookup truth_of;
   if (in.scenario) {
     truth_of = [s = in.scenario](int) {
@@ -197,6 +200,11 @@ void eval_main(const EvalArgs& args) {
     };
   } else {
     io::FolderSource* folder = in.folder;
+    if (folder == nullptr) {
+      throw core::InputError(in.name +
+                             " has no ground truth: eval scores a scenario or a stereo folder with "
+                             "gt/ (use run on recordings and cameras)");
+    }
     if (!folder->has_truth()) {
       throw core::InputError(in.name + " has no ground truth (gt/frames.jsonl)");
     }
@@ -227,13 +235,15 @@ void add_eval_command(CLI::App& app) {
   auto args = std::make_shared<EvalArgs>();
   CLI::App* cmd = app.add_subcommand(
       "eval", "score detections against ground truth (a scenario, or a stereo folder with gt/)");
-  add_input_options(*cmd, args->input);
+  add_input_options(*cmd, args->input, false);
   add_detector_options(*cmd, args->detector);
   cmd->add_option("--json", args->json, "write the metrics as JSON");
   auto* flow_flag = cmd->add_flag("--flow", args->flow,
                 "optical-flow accuracy instead: EPE and bad-3px % against a forward GT .flo");
-  cmd->add_option("--left", args->left, "with --flow: first image (frame 1)");
-  cmd->add_option("--right", args->right, "with --flow: second image (frame 2)");
+  cmd->add_option("--left", args->left,
+                  "left video, image folder or glob; with --flow: first image (frame 1)");
+  cmd->add_option("--right", args->right,
+                  "right video, image folder or glob; with --flow: second image (frame 2)");
   cmd->add_option("--gt", args->gt, "with --flow: GT flow from frame 1 to frame 2 (.flo)");
   cmd->add_option("--dir", args->dir,
                   "with --flow: a folder of pairs (NAME1/NAME2.png + NAME.flo, or "

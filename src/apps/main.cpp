@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   sg::apps::add_eval_command(app);
   sg::apps::add_bench_command(app);
   sg::apps::add_scenarios_command(app);
+  sg::apps::add_calibrate_command(app);
   try {
     if (argc == 1) {
       // No arguments: the main job on its built-in scenario.

@@ -1,20 +1,90 @@
 #include "options.hpp"
 
+#include <cstdio>
+
 #include "sg/core/error.hpp"
 #include "sg/io/config.hpp"
 #include "sg/io/stereo_folder.hpp"
 
 namespace sg::apps {
 
-void add_input_options(CLI::App& app, InputOptions& options) {
+void add_input_options(CLI::App& app, InputOptions& options, bool left_right) {
   auto* scenario = app.add_option("--scenario", options.scenario,
                                   "built-in scenario name or scenario YAML file");
   auto* input = app.add_option("--input", options.input, "stereo folder (see README)");
   scenario->excludes(input);
+  add_source_options(app, options, left_right);
 }
 
-OpenedInput open_input(const InputOptions& options) {
+void add_source_options(CLI::App& app, InputOptions& options, bool left_right) {
+  io::SourceSpec& s = options.spec;
+  if (left_right) {
+    app.add_option("--left", s.left, "left video, image folder or glob pattern ('dir/l*.png')");
+    app.add_option("--right", s.right, "right video, image folder or glob pattern");
+  }
+  app.add_option("--sbs", options.sbs,
+                 "side-by-side video (left half = left image); alone with one --camera: a "
+                 "side-by-side camera")
+      ->expected(0, 1);
+  app.add_option("--kitti", s.kitti, "KITTI raw drive folder (image_00, image_01, timestamps)");
+  app.add_flag("--kitti-color", s.kitti_color, "with --kitti: colour cameras image_02/image_03");
+  app.add_option("--euroc", s.euroc, "EuRoC mav0 folder (cam0, cam1, sensor.yaml, data.csv)");
+  app.add_option("--camera", s.camera, "V4L2 camera indices I,J (or I with --sbs)")->delimiter(',');
+  app.add_option("--calib", s.calib,
+                 "calibration: OpenCV YAML/XML (M1 D1 M2 D2 R T [R1 R2 P1 P2 Q]), KITTI "
+                 "calib_cam_to_cam.txt, or a camera.yaml of a rectified pair");
+  app.add_option("--focal", s.focal_px, "rectified input: focal length, px");
+  app.add_option("--baseline", s.baseline_m, "rectified input: baseline, m");
+  app.add_option("--cx", s.cx, "rectified input: principal point x, px (default: image centre)");
+  app.add_option("--cy", s.cy, "rectified input: principal point y, px (default: image centre)");
+  app.add_option("--input-fps", s.input_fps,
+                 "frame rate of an input without timestamps or a stated rate, Hz (default 30)");
+}
+
+OpenedInput open_input(const InputOptions& options_in, const std::string& config) {
+  InputOptions options = options_in;
+  if (options.sbs) {  // --sbs alone: a side-by-side camera
+    if (options.sbs->empty()) {
+      options.spec.sbs_camera = true;
+    } else {
+      options.spec.sbs = *options.sbs;
+    }
+  }
+  const bool flags =
+      options.spec.any() || options.sbs || !options.input.empty() || !options.scenario.empty();
+  if (!config.empty()) {
+    core::DetectorParams unused;
+    io::RunSettings settings;
+    io::apply_config_file(config, unused, settings);
+    // The input the flags name, else the config's; its camera from the config, flags on top.
+    const io::SourceSpec& c = settings.input;
+    io::SourceSpec merged = flags ? options.spec : c;
+    merged.calib = c.calib;
+    merged.focal_px = c.focal_px;
+    merged.baseline_m = c.baseline_m;
+    merged.cx = c.cx;
+    merged.cy = c.cy;
+    merged.input_fps = c.input_fps;
+    const io::SourceSpec& f = options.spec;
+    if (!f.calib.empty()) merged.calib = f.calib;
+    for (auto [to, from] : {std::pair{&merged.focal_px, &f.focal_px},
+                            {&merged.baseline_m, &f.baseline_m},
+                            {&merged.cx, &f.cx},
+                            {&merged.cy, &f.cy},
+                            {&merged.input_fps, &f.input_fps}}) {
+      if (*from) *to = *from;
+    }
+    options.spec = merged;
+  }
   OpenedInput opened;
+  if (options.spec.any()) {
+    if (!options.input.empty() || !options.scenario.empty()) {
+      throw core::InputError("give one input: --scenario, --input or " + options.spec.name());
+    }
+    opened.name = options.spec.name();
+    opened.source = io::open_source(options.spec);
+    return opened;
+  }
   if (!options.input.empty()) {
     opened.name = options.input;
     auto source = std::make_unique<io::FolderSource>(options.input);
@@ -29,6 +99,15 @@ OpenedInput open_input(const InputOptions& options) {
   opened.scenario = source.get();
   opened.source = std::move(source);
   return opened;
+}
+
+cv::Size parse_size(const std::string& text, const std::string& name, const std::string& example) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x') {
+    throw core::InputError(name + "=" + text + ": must look like " + example);
+  }
+  return {w, h};
 }
 
 void add_detector_options(CLI::App& app, DetectorOptions& o) {
@@ -50,7 +129,8 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                  "farneback");
   app.add_option("--min-area", o.min_area, "smallest obstacle blob, px (default 150)");
   app.add_option("--fps", o.fps, "pace the input like a camera at this rate, Hz (0 = no pacing)");
-  app.add_option("--workers", o.workers, "W: farm workers computing SM/OF tasks at once (default 1)");
+  app.add_option("--workers", o.workers,
+                 "W: farm workers computing SM/OF tasks at once (default 1)");
   app.add_option("--tiles", o.tiles, "T: row tiles per task (default 1)");
   app.add_option("--tokens", o.tokens, "frames in flight (default 0 = W + 1)");
   app.add_option("--threads", o.threads, "threads of the task arena (default 0 = all cores)");

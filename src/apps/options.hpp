@@ -7,16 +7,20 @@
 
 #include "sg/core/params.hpp"
 #include "sg/core/source.hpp"
+#include "sg/io/source_factory.hpp"
 #include "sg/io/stereo_folder.hpp"
 #include "sg/pipeline/runner.hpp"
 #include "sg/sim/renderer.hpp"
 
 namespace sg::apps {
 
-/// --scenario NAME|FILE or --input DIR.
+/// --scenario NAME|FILE, --input DIR, or a real input (--left/--right, --sbs, --kitti, --euroc,
+/// --camera with --calib or --focal/--baseline/--cx/--cy).
 struct InputOptions {
   std::string scenario;
   std::string input;
+  io::SourceSpec spec;
+  std::optional<std::string> sbs;  ///< --sbs FILE, or --sbs alone with one --camera
   /// The default scenario when neither is given; empty = one of them is required.
   std::string fallback_scenario;
 };
@@ -29,8 +33,16 @@ struct OpenedInput {
   io::FolderSource* folder = nullptr;        ///< when the input is a stereo folder
 };
 
-void add_input_options(CLI::App& app, InputOptions& options);
-OpenedInput open_input(const InputOptions& options);
+/// `left_right`: add --left/--right too (eval has its own for --flow and copies them over).
+void add_input_options(CLI::App& app, InputOptions& options, bool left_right = true);
+/// Only the real-input flags (--left/--right, --sbs, --kitti, --euroc, --camera, --calib, ...).
+void add_source_options(CLI::App& app, InputOptions& options, bool left_right = true);
+/// Opens the input; `config` (a --config file, may be empty) supplies its `input:` section when
+/// no input flag is given.
+OpenedInput open_input(const InputOptions& options, const std::string& config = {});
+
+/// "WxH" as a size; InputError "<name>=<text>: must look like <example>" otherwise.
+cv::Size parse_size(const std::string& text, const std::string& name, const std::string& example);
 
 /// Detector flags (--config, --mode, --num-disparities, --block-size, --gaps, --fps, ...).
 struct DetectorOptions {

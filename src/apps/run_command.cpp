@@ -17,7 +17,8 @@ namespace sg::apps {
 namespace {
 
 struct RunArgs {
-  InputOptions input{.scenario = {}, .input = {}, .fallback_scenario = "head-on"};
+  InputOptions input{.scenario = {}, .input = {}, .spec = {}, .sbs = {},
+                     .fallback_scenario = "head-on"};
   DetectorOptions detector;
   std::string events, overlay, summary;
   bool no_timing = false;
@@ -63,12 +64,13 @@ class WarningPrinter {
 
 void run_main(const RunArgs& args) {
   const pipeline::RunOptions options = make_run_options(args.detector);
-  OpenedInput in = open_input(args.input);
+  OpenedInput in = open_input(args.input, args.detector.config);
   const core::Camera& cam = in.source->camera();
   core::throw_if_invalid(pipeline::validate(options, cam), "invalid parameters");
 
   std::string overlay = args.overlay;
-  if (overlay.empty() && args.input.input.empty() && args.input.scenario.empty()) {
+  if (overlay.empty() && args.input.input.empty() && args.input.scenario.empty() &&
+      !args.input.spec.any() && !args.input.sbs) {
     overlay = "stereoguard-" + in.name + ".mp4";
   }
   std::optional<io::EventWriter> events;

@@ -27,6 +27,11 @@ std::vector<std::string> validate(const Camera& c) {
   require(out, std::isfinite(c.cx), "cx", c.cx, "must be a number");
   require(out, std::isfinite(c.cy), "cy", c.cy, "must be a number");
   require(out, std::isfinite(c.fps) && c.fps > 0, "fps", c.fps, "must be a positive number");
+  require(out, !(std::isfinite(c.fps) && c.fps > kMaxFps), "fps", c.fps, "is above any camera's frame rate (max 10000 Hz)");
+  require(out, !(std::isfinite(c.focal_px) && c.focal_px > kMaxFocalPx), "focal_px", c.focal_px,
+          "is above any real lens (max 1e5 px)");
+  require(out, !(std::isfinite(c.baseline_m) && c.baseline_m > kMaxBaselineM), "baseline_m", c.baseline_m,
+          "is above any real stereo rig (max 100 m)");
   return out;
 }
 

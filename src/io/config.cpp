@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "sg/core/error.hpp"
@@ -27,6 +28,15 @@ class Section {
         fail(where_ + "." + key, "has the wrong type");
       }
     }
+    return *this;
+  }
+  Section& field(const char* key, std::optional<double>& out) {
+    if (node_ && node_[key]) {
+      double value = 0;
+      field(key, value);
+      out = value;
+    }
+    known_[key] = true;
     return *this;
   }
   /// Marks `key` as a sub-section read by its own Section.
@@ -82,6 +92,7 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .section("signal")
         .section("flow")
         .section("scene_flow")
+        .section("input")
         .done();
     p.mode = core::parse_mode(mode);
     std::string matcher = core::to_string(p.bm.matcher), cost = core::to_string(p.bm.cost);
@@ -162,6 +173,23 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
           .field("min_inliers", p.scene_flow.ground.min_inliers)
           .done();
     }
+    io::SourceSpec& in = settings.input;
+    Section(root["input"], "input")
+        .field("left", in.left)
+        .field("right", in.right)
+        .field("sbs", in.sbs)
+        .field("sbs_camera", in.sbs_camera)
+        .field("kitti", in.kitti)
+        .field("kitti_color", in.kitti_color)
+        .field("euroc", in.euroc)
+        .field("camera", in.camera)
+        .field("calib", in.calib)
+        .field("focal_px", in.focal_px)
+        .field("baseline_m", in.baseline_m)
+        .field("cx", in.cx)
+        .field("cy", in.cy)
+        .field("fps", in.input_fps)
+        .done();
   } catch (const core::InputError& e) {
     throw core::InputError("config file " + file + ": " + e.what());
   }

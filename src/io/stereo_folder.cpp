@@ -12,15 +12,15 @@
 #include <system_error>
 
 #include "sg/core/error.hpp"
+#include "gray.hpp"
 #include "sg/io/gt_formats.hpp"
 
 namespace sg::io {
 namespace fs = std::filesystem;
+using detail::size_text;
 namespace {
 
-std::string size_text(cv::Size s) {
-  return std::to_string(s.width) + "x" + std::to_string(s.height);
-}
+cv::Mat load_gray(const fs::path& path) { return detail::read_gray(path); }
 
 /// Shortest text that reads back as exactly `v`.
 std::string number_text(double v) {
@@ -57,38 +57,6 @@ std::vector<fs::path> list_pngs(const fs::path& dir, const fs::path& root, const
   std::sort(files.begin(), files.end(),
             [](const fs::path& a, const fs::path& b) { return a.filename() < b.filename(); });
   return files;
-}
-
-/// An image as 8-bit gray (colour converted, 16-bit scaled by 1/257).
-cv::Mat load_gray(const fs::path& path) {
-  cv::Mat raw;
-  try {
-    raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
-    raw.release();
-  }
-  if (raw.empty()) {
-    throw core::InputError("cannot read image (missing, corrupt or not a PNG): " + path.string());
-  }
-  if (raw.depth() != CV_8U && raw.depth() != CV_16U) {
-    throw core::InputError("unsupported image depth (need 8- or 16-bit): " + path.string());
-  }
-  cv::Mat gray;
-  switch (raw.channels()) {
-    case 1: gray = raw; break;
-    case 2: cv::extractChannel(raw, gray, 0); break;
-    case 3: cv::cvtColor(raw, gray, cv::COLOR_BGR2GRAY); break;
-    case 4: cv::cvtColor(raw, gray, cv::COLOR_BGRA2GRAY); break;
-    default:
-      throw core::InputError("unsupported channel count " + std::to_string(raw.channels()) +
-                             ": " + path.string());
-  }
-  if (gray.depth() == CV_16U) {
-    cv::Mat eight;
-    gray.convertTo(eight, CV_8U, 1.0 / 257.0);
-    return eight;
-  }
-  return gray;
 }
 
 /// 8- or 16-bit single channel PNG of a truth map; `type` is the required cv type.

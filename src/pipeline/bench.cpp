@@ -164,6 +164,28 @@ std::string to_csv(const BenchRow& r) {
   return s.str();
 }
 
+/// Up to `frames` frames of `source` in memory, played forwards then backwards when shorter.
+std::vector<core::StereoFrame> read_all(core::FrameSource& source, int frames) {
+  std::vector<core::StereoFrame> read;
+  while (static_cast<int>(read.size()) < frames) {
+    std::optional<core::StereoFrame> f = source.next();
+    if (!f) break;
+    read.push_back(std::move(*f));
+  }
+  if (read.empty()) throw core::InputError("the bench input has no frames");
+  std::vector<core::StereoFrame> out;
+  const int n = static_cast<int>(read.size());
+  const int period = std::max(1, 2 * n - 2);
+  for (int i = 0; i < frames; ++i) {
+    const int k = i % period;
+    core::StereoFrame f = read[k < n ? k : period - k];
+    f.index = i;
+    f.time_s = i / source.camera().fps;
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
 std::vector<BenchRow> run_bench(const BenchConfig& config,
                                 const std::function<void(const BenchRow&)>& on_row) {
   core::throw_if_invalid(validate(config), "invalid bench settings");
@@ -174,10 +196,16 @@ std::vector<BenchRow> run_bench(const BenchConfig& config,
     rows.push_back(std::move(row));
   };
 
-  for (size_t r = 0; r < config.resolutions.size(); ++r) {
-    const cv::Size size = config.resolutions[r];
+  std::unique_ptr<core::FrameSource> input = config.open_input ? config.open_input() : nullptr;
+  const std::vector<cv::Size> sizes =
+      input ? std::vector<cv::Size>{{input->camera().width, input->camera().height}}
+            : config.resolutions;
+  for (size_t r = 0; r < sizes.size(); ++r) {
+    const cv::Size size = sizes[r];
     const sim::Scenario scenario = scaled(base, size, base.frames);
-    const std::vector<core::StereoFrame> frames = render(scenario, config.frames);
+    const core::Camera camera = input ? input->camera() : scenario.camera;
+    const std::vector<core::StereoFrame> frames =
+        input ? read_all(*input, config.frames) : render(scenario, config.frames);
     for (core::Mode mode : config.modes) {
       RunOptions options;
       options.params.mode = mode;
@@ -185,14 +213,14 @@ std::vector<BenchRow> run_bench(const BenchConfig& config,
       options.params.bm.matcher = config.matcher;
       options.params.bm.cost = config.cost;
       options.threads = config.threads;
-      core::throw_if_invalid(validate(options, scenario.camera), "invalid bench settings");
+      core::throw_if_invalid(validate(options, camera), "invalid bench settings");
 
-      Measured baseline = run_baseline(frames, scenario.camera, options.params, 1);
+      Measured baseline = run_baseline(frames, camera, options.params, 1);
       baseline.row.mode = core::to_string(mode);
       baseline.row.resolution = size;
       baseline.row.speedup = 1.0;
       emit(baseline.row);
-      Measured opencv_mt = run_baseline(frames, scenario.camera, options.params, -1);
+      Measured opencv_mt = run_baseline(frames, camera, options.params, -1);
       opencv_mt.row.mode = baseline.row.mode;
       opencv_mt.row.resolution = size;
       opencv_mt.row.speedup = opencv_mt.row.fps / baseline.row.fps;
@@ -204,7 +232,7 @@ std::vector<BenchRow> run_bench(const BenchConfig& config,
         for (int t : config.tiles) {
           options.workers = w;
           options.tiles = t;
-          Measured m = run_pipeline(frames, scenario.camera, options);
+          Measured m = run_pipeline(frames, camera, options);
           m.row.mode = core::to_string(mode);
           m.row.resolution = size;
           m.row.speedup = m.row.fps / baseline.row.fps;
@@ -218,7 +246,7 @@ std::vector<BenchRow> run_bench(const BenchConfig& config,
         options.workers = best.row.workers;
         options.tiles = best.row.tiles;
         options.pace_fps = fraction * best.row.fps;
-        Measured m = run_pipeline(frames, scenario.camera, options);
+        Measured m = run_pipeline(frames, camera, options);
         options.pace_fps = 0;
         m.row.mode = core::to_string(mode);
         m.row.resolution = size;

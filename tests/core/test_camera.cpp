@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "sg/core/camera.hpp"
 
 namespace sg::core {
@@ -32,6 +34,35 @@ TEST(Camera, ValidateNamesEachBadField) {
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_NE(problems[0].find("camera.focal_px=0"), std::string::npos);
   EXPECT_NE(problems[1].find("camera.fps=-30"), std::string::npos);
+}
+
+TEST(Camera, ValidateRejectsPhysicallyImpossibleValues) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Case {
+    double Camera::*field;
+    double value;
+    const char* needle;
+  };
+  const Case cases[] = {
+      {&Camera::fps, 0.0, "camera.fps=0"},         {&Camera::fps, -5.0, "camera.fps=-5"},
+      {&Camera::fps, inf, "camera.fps=inf"},       {&Camera::fps, nan, "camera.fps=nan"},
+      {&Camera::fps, 1e7, "camera.fps=1e+07"},     {&Camera::focal_px, nan, "camera.focal_px=nan"},
+      {&Camera::focal_px, -1, "camera.focal_px=-1"}, {&Camera::focal_px, inf, "camera.focal_px=inf"},
+      {&Camera::baseline_m, 0, "camera.baseline_m=0"},
+      {&Camera::baseline_m, nan, "camera.baseline_m=nan"},
+      {&Camera::baseline_m, 1e6, "camera.baseline_m=1e+06"},
+  };
+  for (const Case& c : cases) {
+    Camera cam;
+    cam.*c.field = c.value;
+    const auto problems = validate(cam);
+    ASSERT_FALSE(problems.empty()) << c.needle;
+    EXPECT_NE(problems[0].find(c.needle), std::string::npos) << problems[0];
+  }
+  Camera fast;
+  fast.fps = 1000.0;  // a high-speed camera is still a camera
+  EXPECT_TRUE(validate(fast).empty());
 }
 
 }  // namespace

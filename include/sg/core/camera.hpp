@@ -33,7 +33,14 @@ struct Camera {
   double frame_period() const { return 1.0 / fps; }
 };
 
-/// Every violation as "camera.<field>=<value>: <rule>"; empty when valid.
+/// Physical upper bounds checked by validate(Camera): beyond them a value is a typo or a broken
+/// calibration, not a camera.
+inline constexpr double kMaxFps = 10000.0;       ///< Hz (high-speed cameras reach a few thousand)
+inline constexpr double kMaxFocalPx = 1.0e5;     ///< px
+inline constexpr double kMaxBaselineM = 100.0;   ///< m
+
+/// Every violation as "camera.<field>=<value>: <rule>"; empty when valid: sizes positive; focal,
+/// baseline and fps finite, positive and below the kMax bounds; cx, cy finite.
 std::vector<std::string> validate(const Camera& camera);
 
 }  // namespace sg::core

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "sg/core/params.hpp"
+#include "sg/io/source_factory.hpp"
 
 namespace sg::io {
 
@@ -13,6 +14,9 @@ struct RunSettings {
   int tiles = 1;          ///< `tiles:` T, row tiles per task
   int tokens = 0;         ///< `tokens:` frames in flight (0 = automatic)
   int threads = 0;        ///< `threads:` task-arena size (0 = all cores)
+  /// `input:` section: left, right, sbs, sbs_camera, kitti, kitti_color, euroc, camera [I, J],
+  /// calib, focal_px, baseline_m, cx, cy, fps (the rate of an input without one). Flags win.
+  SourceSpec input;
 };
 
 /// Overwrites the fields of `params` (and `settings`) that the file sets; others keep their value.

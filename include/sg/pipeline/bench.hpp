@@ -3,11 +3,13 @@
 /// frames rendered once and held in memory, beside the baseline a user would write (a plain
 /// sequential OpenCV loop) measured in the same run.
 #include <functional>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
 #include "sg/core/params.hpp"
+#include "sg/core/source.hpp"
 
 namespace sg::pipeline {
 
@@ -26,6 +28,10 @@ struct BenchConfig {
   /// Also run the best configuration of each mode (first resolution) paced at these fractions of
   /// its measured capacity (empty = none).
   std::vector<double> pace_fractions = {0.8, 1.5};
+  /// When set, the frames come from this input instead of the scenario: read once into memory (up
+  /// to `frames`, played forwards then backwards when shorter), at the input's own resolution and
+  /// camera; `scenario` and `resolutions` are then ignored.
+  std::function<std::unique_ptr<core::FrameSource>()> open_input;
 };
 
 std::vector<std::string> validate(const BenchConfig& config);

@@ -1,0 +1,143 @@
+#pragma once
+/// Frame sources for real inputs (README "Inputs"): image pairs (two folders, two glob patterns,
+/// KITTI raw, EuRoC), videos and V4L2 cameras (two, or one side-by-side), and the rectifying
+/// decorator that wraps any of them.
+///
+/// Every source here gives the same frames through next() as through next_pending() + load():
+/// next() is next_pending() followed by load().
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <opencv2/videoio.hpp>
+#include <string>
+#include <vector>
+
+#include "sg/core/source.hpp"
+#include "sg/io/calibration.hpp"
+
+namespace sg::io {
+
+/// A source whose next() is next_pending() + load(), so both ways give the same frames.
+class DeferredSource : public core::FrameSource {
+ public:
+  std::optional<core::StereoFrame> next() final;
+};
+
+/// One stereo pair of image files and its acquisition time.
+struct ImagePair {
+  std::filesystem::path left, right;
+  double time_s = 0.0;  ///< stream time, s (0 for the first frame)
+};
+
+/// Image pairs read lazily. The constructor reads the first pair (so an unreadable file or left and
+/// right sizes that differ fail at once) and sets camera().width/height from it. next_pending()
+/// defers imread + gray conversion to load(), which checks that the frame has the first frame's
+/// size (InputError naming the file otherwise).
+class ImageListSource : public DeferredSource {
+ public:
+  /// `camera`: focal, baseline, cx, cy, fps of the stream (width/height are overwritten).
+  ImageListSource(std::vector<ImagePair> pairs, const core::Camera& camera);
+  std::optional<core::PendingFrame> next_pending() override;
+  const core::Camera& camera() const override { return camera_; }
+  int size() const override { return static_cast<int>(pairs_.size()); }
+
+ private:
+  std::vector<ImagePair> pairs_;
+  core::Camera camera_;
+  int next_index_ = 0;
+};
+
+/// Videos and cameras through cv::VideoCapture: two captures (left, right), or one side-by-side
+/// capture whose left half is the left image. Frames are grabbed and decoded serially in
+/// next_pending(); gray conversion and the split happen in load(). Recorded videos are stamped
+/// index / fps (the container's nominal rate); cameras by the clock at the grab, paced by the
+/// camera. When one of two videos ends before the other the stream stops at the shorter, with one
+/// warning line on stderr. A video that ends well before the frame count its container states
+/// (truncated) or stops decoding is an InputError.
+class CaptureSource : public DeferredSource {
+ public:
+  /// Two video files. `camera` gives focal, baseline, cx, cy, and fps when the videos have none.
+  static std::unique_ptr<CaptureSource> open_videos(const std::string& left,
+                                                    const std::string& right,
+                                                    const core::Camera& camera);
+  /// One side-by-side video file (even width).
+  static std::unique_ptr<CaptureSource> open_sbs_video(const std::string& path,
+                                                       const core::Camera& camera);
+  /// V4L2 devices /dev/video<left>, /dev/video<right>; right < 0 = one side-by-side device.
+  /// A device that does not exist or does not open is an InputError at once.
+  static std::unique_ptr<CaptureSource> open_cameras(int left, int right,
+                                                     const core::Camera& camera);
+
+  std::optional<core::PendingFrame> next_pending() override;
+  const core::Camera& camera() const override { return camera_; }
+  int size() const override { return frame_count_; }
+
+ private:
+  struct Capture {
+    std::string name;  ///< file path or /dev/videoN, for messages
+    cv::VideoCapture capture;
+    int declared_frames = -1;  ///< the container's frame count, -1 unknown
+  };
+  CaptureSource(std::vector<Capture> captures, bool live, const core::Camera& camera);
+  /// Grabs one frame of every capture; false at the end of the stream.
+  bool grab(std::vector<cv::Mat>& frames);
+
+  std::vector<Capture> captures_;
+  bool live_;
+  core::Camera camera_;
+  int frame_count_ = -1;
+  int next_index_ = 0;
+  std::vector<cv::Mat> first_;  ///< the first frame, read by the constructor to learn the size
+  std::chrono::steady_clock::time_point start_;
+};
+
+/// Decorator: rectifies the frames of `inner` with maps computed once from a raw calibration.
+/// load() chains the inner load() then remaps (bilinear). camera() is the rectified camera with the
+/// inner source's fps.
+class RectifiedSource : public DeferredSource {
+ public:
+  RectifiedSource(std::unique_ptr<core::FrameSource> inner, const StereoCalibration& calib,
+                  const std::string& where);
+  std::optional<core::PendingFrame> next_pending() override;
+  const core::Camera& camera() const override { return rectification_->camera; }
+  int size() const override { return inner_->size(); }
+
+ private:
+  std::unique_ptr<core::FrameSource> inner_;
+  std::shared_ptr<const Rectification> rectification_;
+};
+
+/// Rectifies one pair with `r` (what RectifiedSource::load does).
+void rectify(const Rectification& r, core::StereoFrame& frame);
+
+/// Images of a folder (png, jpg, jpeg, bmp, pgm, ppm, tif, tiff), or the files matching a glob
+/// pattern (`dir/left*.jpg`), sorted by name. Throws InputError when the folder or pattern gives no
+/// image.
+std::vector<std::filesystem::path> list_images(const std::string& folder_or_glob);
+
+/// Sets cx, cy to the image centre ((width - 1) / 2, (height - 1) / 2) where they are NaN (not
+/// given); ImageListSource and CaptureSource call it once they know the size.
+void centre_unknown_principal_point(core::Camera& camera);
+
+/// min(left, right); when they differ, prints one line "stereoguard: warning: ..." on stderr
+/// naming both (a stream stops at the shorter side).
+size_t shorter_count(size_t left, size_t right, const std::string& left_name,
+                     const std::string& right_name);
+
+/// Frame rate from acquisition times: 1 / median interval, Hz; 0 when fewer than 2 times or the
+/// median is not positive.
+double fps_from_times(const std::vector<double>& times_s);
+
+/// KITTI raw drive: DIR/image_00/data/*.png + image_01 (or image_02/03 when `color`),
+/// DIR/image_0X/timestamps.txt ("YYYY-MM-DD hh:mm:ss.fffffffff", optional: else `camera.fps`),
+/// calibration from `calib` (default: calib_cam_to_cam.txt in DIR or in its parent, as KITTI
+/// unpacks it). The images are taken as rectified (the synced+rectified product).
+std::unique_ptr<core::FrameSource> open_kitti(const std::filesystem::path& dir, bool color,
+                                              const std::filesystem::path& calib);
+
+/// EuRoC MAV folder (the mav0 folder, or its parent): cam0 (left), cam1 (right), each with
+/// data.csv (timestamp ns, file name), data/ and sensor.yaml. Left and right are paired by equal
+/// timestamps (frames without a partner are skipped); rectified with the sensor.yaml pair.
+std::unique_ptr<core::FrameSource> open_euroc(const std::filesystem::path& dir);
+
+}  // namespace sg::io
