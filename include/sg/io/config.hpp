@@ -1,6 +1,7 @@
 #pragma once
 /// The YAML configuration file: mirrors the command-line flags (README "Configuration").
 #include <filesystem>
+#include <string>
 
 #include "sg/core/params.hpp"
 
@@ -13,6 +14,9 @@ struct RunSettings {
   int tiles = 1;          ///< `tiles:` T, row tiles per task
   int tokens = 0;         ///< `tokens:` frames in flight (0 = automatic)
   int threads = 0;        ///< `threads:` task-arena size (0 = all cores)
+  double scale = 1.0;     ///< `scale:` resize factor of the input images (run --scale)
+  std::string csv;        ///< `csv:` per-frame metrics CSV file, empty = none (--csv)
+  std::string dump;       ///< `dump:` folder of per-frame PNGs, empty = none (--dump)
 };
 
 /// Overwrites the fields of `params` (and `settings`) that the file sets; others keep their value.
