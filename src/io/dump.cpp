@@ -60,16 +60,7 @@ cv::Mat colorize_disparity(const cv::Mat& disparity, double max_disparity_px) {
 cv::Mat colorize_flow(const cv::Mat& flow, double max_radius_px) {
   CV_Assert(flow.type() == CV_32FC2);
   static const std::vector<cv::Vec3d> wheel = make_color_wheel();
-  double scale = max_radius_px;
-  if (scale <= 0) {
-    scale = 1.0;
-    for (int y = 0; y < flow.rows; ++y) {
-      for (const cv::Vec2f& f : cv::Mat_<cv::Vec2f>(flow.row(y))) {
-        const double r = std::hypot(f[0], f[1]);
-        if (std::isfinite(r)) scale = std::max(scale, r);
-      }
-    }
-  }
+  const double scale = max_radius_px > 0 ? max_radius_px : flow_color_scale(flow);
   cv::Mat color(flow.size(), CV_8UC3);
   for (int y = 0; y < flow.rows; ++y) {
     const cv::Vec2f* in = flow.ptr<cv::Vec2f>(y);
@@ -81,6 +72,21 @@ cv::Mat colorize_flow(const cv::Mat& flow, double max_radius_px) {
     }
   }
   return color;
+}
+
+double flow_color_scale(const cv::Mat& flow, const cv::Mat& mask) {
+  CV_Assert(flow.type() == CV_32FC2 && (mask.empty() || mask.size() == flow.size()));
+  double scale = 1.0;
+  for (int y = 0; y < flow.rows; ++y) {
+    const cv::Vec2f* in = flow.ptr<cv::Vec2f>(y);
+    const uchar* m = mask.empty() ? nullptr : mask.ptr<uchar>(y);
+    for (int x = 0; x < flow.cols; ++x) {
+      if (m && !m[x]) continue;
+      const double r = std::hypot(in[x][0], in[x][1]);
+      if (std::isfinite(r)) scale = std::max(scale, r);
+    }
+  }
+  return scale;
 }
 
 DumpWriter::DumpWriter(const fs::path& dir, double max_disparity_px)
@@ -116,7 +122,10 @@ void DumpWriter::write(const core::Detection& d) {
   if (!d.disparity.empty()) {
     write_png(path("disparity", d.frame), colorize_disparity(d.disparity, max_disparity_px_));
   }
-  if (!d.flow.empty()) write_png(path("flow", d.frame), colorize_flow(d.flow));
+  if (!d.flow.empty()) {
+    const cv::Mat valid = d.disparity.empty() ? cv::Mat() : cv::Mat(d.disparity >= 0);
+    write_png(path("flow", d.frame), colorize_flow(d.flow, flow_color_scale(d.flow, valid)));
+  }
   if (!d.danger.empty()) write_png(path("danger", d.frame), d.danger);
 }
 

@@ -124,6 +124,17 @@ TEST(FlowColors, AutomaticScaleIsTheLargestMagnitude) {
   expect_bgr(color.at<cv::Vec3b>(0, 0), 255, 255, 255);
 }
 
+TEST(FlowColors, ScaleOverAMaskIgnoresPixelsOutsideIt) {
+  cv::Mat flow(2, 2, CV_32FC2, cv::Scalar(0.5f, 0));
+  flow.at<cv::Vec2f>(0, 0) = {30, 40};  // 50 px, outside the mask
+  flow.at<cv::Vec2f>(1, 1) = {0, 3};
+  cv::Mat mask(2, 2, CV_8U, cv::Scalar(255));
+  mask.at<uchar>(0, 0) = 0;
+  EXPECT_DOUBLE_EQ(flow_color_scale(flow), 50.0);
+  EXPECT_DOUBLE_EQ(flow_color_scale(flow, mask), 3.0);
+  EXPECT_DOUBLE_EQ(flow_color_scale(cv::Mat(2, 2, CV_32FC2, cv::Scalar(0.1f, 0))), 1.0);  // floor
+}
+
 TEST(DisparityColors, InvalidBlackNearRedFarBlueClampedAboveTheMaximum) {
   cv::Mat disp = (cv::Mat_<float>(1, 4) << -1.f, 0.f, 64.f, 500.f);
   const cv::Mat color = colorize_disparity(disp, 64.0);

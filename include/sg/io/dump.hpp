@@ -20,13 +20,19 @@ cv::Mat colorize_disparity(const cv::Mat& disparity, double max_disparity_px);
 /// the largest finite magnitude of the field (at least 1 px), as the Middlebury tool does.
 cv::Mat colorize_flow(const cv::Mat& flow, double max_radius_px = 0.0);
 
+/// Largest finite flow magnitude (px, at least 1) over the pixels where `mask` (CV_8U, same size,
+/// may be empty = all pixels) is non-zero: the colour scale of colorize_flow.
+double flow_color_scale(const cv::Mat& flow, const cv::Mat& mask = cv::Mat());
+
 class DumpWriter {
  public:
   /// Creates `dir` (and its parents) when missing. Throws core::InputError naming --dump when it
   /// is a file or cannot be created. max_disparity_px sets the disparity colour scale.
   DumpWriter(const std::filesystem::path& dir, double max_disparity_px);
   /// Writes the maps of detection `d` (its danger mask, and its disparity and flow when present)
-  /// as PNGs named by d.frame. Throws core::InputError when a file cannot be written.
+  /// as PNGs named by d.frame. The flow colour scale is the largest flow magnitude among pixels
+  /// with a valid disparity: textureless areas (sky, blank walls) give meaningless flow that would
+  /// otherwise wash out every other colour. Throws core::InputError when a file cannot be written.
   void write(const core::Detection& d);
   /// Path of the `kind` ("disparity", "flow", "danger") PNG of `frame`.
   std::filesystem::path path(const std::string& kind, int frame) const;
