@@ -24,6 +24,9 @@ function(sg_library layer)
     $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:include>)
   target_link_libraries(sg_${layer} PUBLIC ${ARG_DEPS})
   sg_target_options(sg_${layer})
+  # Installed as sg::<layer> by cmake/sg_install.cmake (find_package(stereoguard)).
+  set_target_properties(sg_${layer} PROPERTIES EXPORT_NAME ${layer})
+  install(TARGETS sg_${layer} EXPORT stereoguardTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endfunction()
 
 # sg_test(<name> SOURCES ... DEPS ... [LABELS ...]): a GoogleTest executable registered with CTest.

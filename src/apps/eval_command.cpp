@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "eval_stereo.hpp"
 #include "options.hpp"
+#include "outputs.hpp"
 #include "sg/core/error.hpp"
 #include "sg/eval/flow_metrics.hpp"
 #include "sg/io/gt_formats.hpp"
@@ -26,6 +27,8 @@ namespace fs = std::filesystem;
 struct EvalArgs {
   InputOptions input;
   DetectorOptions detector;
+  OutputOptions outputs;
+  bool quiet = false;
   std::string json;
   // --flow: optical-flow accuracy on image pairs with a forward GT flow (Middlebury .flo).
   bool flow = false;
@@ -188,7 +191,13 @@ void eval_main(const EvalArgs& args) {
     eval_stereo_main(s);
     return;
   }
-  const pipeline::RunOptions options = make_run_options(args.detector);
+  io::RunSettings settings;
+  pipeline::RunOptions options = make_run_options(args.detector, &settings);
+  const ResolvedOutputs outputs = resolve_outputs(args.outputs, settings);
+  if (outputs.scale != 1.0) {
+    throw core::InputError("scale: eval does not rescale the ground truth; use scale only with run");
+  }
+  options.keep_maps = !outputs.dump.empty();
   InputOptions input = args.input;
   input.spec.left = args.left;  // --left/--right are shared with --flow
   input.spec.right = args.right;
@@ -212,7 +221,13 @@ void eval_main(const EvalArgs& args) {
       return pipeline::FrameTruthView{folder->truth(i), folder->truth_maps(i).danger};
     };
   }
-  const pipeline::Evaluation result = pipeline::evaluate(*in.source, truth_of, options);
+  FrameOutputs frame_outputs(outputs, true, !args.quiet && io::stderr_is_terminal(),
+                             in.source->size(),
+                             options.params.bm.min_disparity + options.params.bm.num_disparities);
+  const pipeline::Evaluation result = pipeline::evaluate(
+      *in.source, truth_of, options,
+      [&](const core::StereoFrame&, const core::Detection& d) { frame_outputs.write(d); });
+  frame_outputs.clear_progress();
   std::cout << "eval " << in.name << " (mode " << core::to_string(options.params.mode) << ")\n"
             << result.report.table();
   if (!args.json.empty()) {
@@ -227,6 +242,7 @@ void eval_main(const EvalArgs& args) {
     out << j.dump(2) << "\n";
     std::cout << "json              " << args.json << "\n";
   }
+  frame_outputs.finish(std::cout);
 }
 
 }  // namespace
@@ -238,6 +254,8 @@ void add_eval_command(CLI::App& app) {
   add_input_options(*cmd, args->input, false);
   add_detector_options(*cmd, args->detector);
   cmd->add_option("--json", args->json, "write the metrics as JSON");
+  add_output_options(*cmd, args->outputs, /*with_scale=*/false);
+  cmd->add_flag("--quiet", args->quiet, "no progress bar (shown only when stderr is a terminal)");
   auto* flow_flag = cmd->add_flag("--flow", args->flow,
                 "optical-flow accuracy instead: EPE and bad-3px % against a forward GT .flo");
   cmd->add_option("--left", args->left,

@@ -26,7 +26,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    // One line like every other user error (CLI11's own exit() adds a second, generic line).
+    std::cerr << "stereoguard: error: " << e.what() << " (see --help)\n";
     return 2;
   } catch (const sg::core::InputError& e) {
     std::cerr << "stereoguard: error: " << e.what() << "\n";

@@ -138,10 +138,11 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                "split optical flow into the T tiles too (faster, not bit-identical)");
 }
 
-pipeline::RunOptions make_run_options(const DetectorOptions& o) {
+pipeline::RunOptions make_run_options(const DetectorOptions& o, io::RunSettings* settings_out) {
   pipeline::RunOptions run;
   io::RunSettings settings;
   if (!o.config.empty()) io::apply_config_file(o.config, run.params, settings);
+  if (settings_out) *settings_out = settings;
   run.pace_fps = settings.pace_fps;
   run.workers = settings.workers;
   run.tiles = settings.tiles;

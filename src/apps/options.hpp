@@ -7,6 +7,7 @@
 
 #include "sg/core/params.hpp"
 #include "sg/core/source.hpp"
+#include "sg/io/config.hpp"
 #include "sg/io/source_factory.hpp"
 #include "sg/io/stereo_folder.hpp"
 #include "sg/pipeline/runner.hpp"
@@ -59,6 +60,8 @@ struct DetectorOptions {
 
 void add_detector_options(CLI::App& app, DetectorOptions& options);
 /// Defaults, then the config file, then the flags. Not validated here (pipeline::run does).
-pipeline::RunOptions make_run_options(const DetectorOptions& options);
+/// `settings`, when given, receives the config file's run settings (outputs, scale).
+pipeline::RunOptions make_run_options(const DetectorOptions& options,
+                                      io::RunSettings* settings = nullptr);
 
 }  // namespace sg::apps

@@ -6,12 +6,15 @@
 #include <iomanip>
 #include <iostream>
 #include <optional>
+#include <sstream>
 
 #include "commands.hpp"
 #include "options.hpp"
+#include "outputs.hpp"
 #include "sg/core/error.hpp"
 #include "sg/io/events.hpp"
 #include "sg/io/overlay.hpp"
+#include "sg/io/scaled_source.hpp"
 
 namespace sg::apps {
 namespace {
@@ -20,6 +23,7 @@ struct RunArgs {
   InputOptions input{.scenario = {}, .input = {}, .spec = {}, .sbs = {},
                      .fallback_scenario = "head-on"};
   DetectorOptions detector;
+  OutputOptions outputs;
   std::string events, overlay, summary;
   bool no_timing = false;
   bool quiet = false;
@@ -28,7 +32,7 @@ struct RunArgs {
 /// One line when the warning state changes, so a user sees the warnings as they happen.
 class WarningPrinter {
  public:
-  void operator()(const core::Detection& d) {
+  void operator()(const core::Detection& d, std::ostream& out) {
     // Severity flickers with the TTC estimate: say only when it rises above what this warning
     // already said.
     const bool changed = d.signal != last_signal_ || d.steering != last_steering_ ||
@@ -37,23 +41,23 @@ class WarningPrinter {
     last_steering_ = d.steering;
     last_severity_ = d.signal ? std::max(last_severity_, d.severity) : core::Severity::kNone;
     if (!changed) return;
-    std::cout << "frame " << std::setw(4) << d.frame << "  t=" << std::fixed
+    out << "frame " << std::setw(4) << d.frame << "  t=" << std::fixed
               << std::setprecision(2) << d.time_s << " s  ";
     if (!d.signal) {
-      std::cout << "clear\n";
+      out << "clear\n";
       return;
     }
-    std::cout << (d.severity == core::Severity::kDanger ? "DANGER " : "WARNING") << "  regions";
+    out << (d.severity == core::Severity::kDanger ? "DANGER " : "WARNING") << "  regions";
     for (const auto& r : d.regions)
-      if (r.fired) std::cout << " " << r.name;
+      if (r.fired) out << " " << r.name;
     const core::Obstacle* nearest = nullptr;
     for (const auto& o : d.obstacles)
       if (!nearest || o.distance_m < nearest->distance_m) nearest = &o;
     if (nearest) {
-      std::cout << std::setprecision(1) << "  nearest " << nearest->distance_m << " m";
-      if (nearest->ttc_s) std::cout << ", TTC " << *nearest->ttc_s << " s";
+      out << std::setprecision(1) << "  nearest " << nearest->distance_m << " m";
+      if (nearest->ttc_s) out << ", TTC " << *nearest->ttc_s << " s";
     }
-    std::cout << "  steer " << core::to_string(d.steering) << "\n";
+    out << "  steer " << core::to_string(d.steering) << "\n";
   }
 
  private:
@@ -63,8 +67,12 @@ class WarningPrinter {
 };
 
 void run_main(const RunArgs& args) {
-  const pipeline::RunOptions options = make_run_options(args.detector);
+  io::RunSettings settings;
+  pipeline::RunOptions options = make_run_options(args.detector, &settings);
+  const ResolvedOutputs outputs = resolve_outputs(args.outputs, settings);
+  options.keep_maps = !outputs.dump.empty();
   OpenedInput in = open_input(args.input, args.detector.config);
+  in.source = io::scale_source(std::move(in.source), outputs.scale);
   const core::Camera& cam = in.source->camera();
   core::throw_if_invalid(pipeline::validate(options, cam), "invalid parameters");
 
@@ -75,6 +83,9 @@ void run_main(const RunArgs& args) {
   }
   std::optional<io::EventWriter> events;
   if (!args.events.empty()) events.emplace(args.events, !args.no_timing);
+  FrameOutputs frame_outputs(outputs, !args.no_timing, !args.quiet && io::stderr_is_terminal(),
+                             in.source->size(),
+                             options.params.bm.min_disparity + options.params.bm.num_disparities);
   // The video is written under a temporary name and renamed only when the run succeeds, so a
   // failed run never leaves a truncated video that looks complete.
   const std::string overlay_partial = overlay + ".partial.mp4";
@@ -85,13 +96,21 @@ void run_main(const RunArgs& args) {
             << (in.source->size() >= 0 ? std::to_string(in.source->size()) + " frames, " : "")
             << "mode " << core::to_string(options.params.mode) << "\n";
   WarningPrinter printer;
+  std::ostringstream warning;
   pipeline::RunSummary summary;
   try {
     summary = pipeline::run(*in.source, options,
                             [&](const core::StereoFrame& frame, const core::Detection& d) {
                               if (events) events->write(d);
                               if (video) video->write(frame, d);
-                              if (!args.quiet) printer(d);
+                              frame_outputs.write(d);
+                              if (args.quiet) return;
+                              warning.str("");
+                              printer(d, warning);
+                              if (warning.tellp() > 0) {
+                                frame_outputs.clear_progress();
+                                std::cout << warning.str() << std::flush;
+                              }
                             });
   } catch (...) {
     if (video) {
@@ -100,6 +119,7 @@ void run_main(const RunArgs& args) {
     }
     throw;
   }
+  frame_outputs.clear_progress();
   std::cout << "\n" << summary.text();
   if (video) {
     video->close();
@@ -108,6 +128,7 @@ void run_main(const RunArgs& args) {
               << " frames)\n";
   }
   if (events) std::cout << "events            " << args.events << "\n";
+  frame_outputs.finish(std::cout);
   if (!args.summary.empty()) {
     std::ofstream out(args.summary);
     if (!out) throw core::InputError("cannot write summary file " + args.summary);
@@ -130,7 +151,10 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--summary", args->summary, "write the run summary as JSON");
   cmd->add_flag("--no-timing", args->no_timing,
                 "leave latency_ms out of the events (byte-identical repeated runs)");
-  cmd->add_flag("--quiet", args->quiet, "do not print warnings as they happen");
+  add_output_options(*cmd, args->outputs, /*with_scale=*/true);
+  cmd->add_flag("--quiet", args->quiet,
+                "do not print warnings as they happen, nor the progress bar (shown only when "
+                "stderr is a terminal)");
   cmd->callback([args] { run_main(*args); });
 }
 

@@ -178,6 +178,10 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   auto collect = [&](FrameJob&& job) {
     const par::Stopwatch watch;
     core::Detection detection = detector.process(job.frame, job.maps);
+    if (options.keep_maps) {
+      detection.disparity = job.maps.disparity;
+      detection.flow = job.maps.flow;
+    }
     const par::TimePoint done = par::now();
     detection.latency_ms = par::elapsed_ms(job.acquired, done);
     latency.add(detection.latency_ms);

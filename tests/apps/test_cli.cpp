@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -429,6 +430,170 @@ TEST_F(Cli, EvalFlowOnMiddleburyAndFlyingChairs) {
     EXPECT_GT(epe, 0.0) << m;
     EXPECT_LT(epe, 8.0) << m;  // large chair motions; zero flow is about 10 px here
   }
+}
+
+// ---- Outputs (issue 7b): --csv, --dump, --scale, the progress bar ----
+
+std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(p);
+  std::string line;
+  while (std::getline(in, line)) {
+    rows.emplace_back(1);
+    for (char c : line) {
+      if (c == ',')
+        rows.back().emplace_back();
+      else
+        rows.back().back() += c;
+    }
+  }
+  return rows;
+}
+
+TEST_F(Cli, CsvHasAHeaderAndOneRowPerFrameAgreeingWithTheEvents) {
+  const Result r = run("run --quiet --scenario '" + small_scenario().string() +
+                       "' --csv m.csv --events e.jsonl");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = read_csv(dir_ / "m.csv");
+  const auto events = read_events(dir_ / "e.jsonl");
+  ASSERT_EQ(rows.size(), 13u);
+  ASSERT_EQ(events.size(), 12u);
+  const std::vector<std::string> header = rows[0];
+  ASSERT_EQ(header.size(), 11u);
+  EXPECT_EQ(header[0], "frame");
+  EXPECT_EQ(header[10], "latency_ms");
+  int alarms = 0;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    ASSERT_EQ(rows[i].size(), header.size()) << i;
+    const auto& e = events[i - 1];
+    EXPECT_EQ(std::stoi(rows[i][0]), e["frame"].get<int>());
+    EXPECT_EQ(rows[i][2], e["signal"].get<bool>() ? "1" : "0");
+    EXPECT_EQ(rows[i][3], e["severity"].get<std::string>());
+    EXPECT_EQ(std::stoi(rows[i][7]), static_cast<int>(e["obstacles"].size()));
+    EXPECT_FALSE(rows[i][10].empty());
+    alarms += rows[i][2] == "1";
+  }
+  EXPECT_GT(alarms, 0);  // the small scenario's box approaches: the rows carry real alarms
+  EXPECT_NE(r.out.find("csv               m.csv (12 rows)"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, CsvOfAFailedRunKeepsItsCompleteRows) {
+  const fs::path folder = small_folder(6);
+  std::ofstream(folder / "left" / "000004.png", std::ios::binary) << "not a png at all";
+  const Result r = run("run --quiet --input '" + folder.string() + "' --csv m.csv");
+  expect_user_error(r, "000004.png");
+  const auto rows = read_csv(dir_ / "m.csv");
+  ASSERT_EQ(rows.size(), 5u);  // header + frames 0..3
+  for (size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i].size(), rows[0].size());
+    EXPECT_EQ(rows[i][0], std::to_string(i - 1));
+  }
+}
+
+TEST_F(Cli, DumpWritesDisparityFlowAndDangerPngsPerFrame) {
+  const Result r = run("run --quiet --mode stereo-flow --scenario '" + small_scenario(6).string() +
+                       "' --dump out/d");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const fs::path d = dir_ / "out" / "d";
+  for (int i = 0; i < 6; ++i) {
+    char name[32];
+    for (const char* kind : {"disparity", "flow", "danger"}) {
+      std::snprintf(name, sizeof name, "%s_%06d.png", kind, i);
+      const bool expected = i > 0 || std::string(kind) != "flow";  // no flow for the first frame
+      ASSERT_EQ(fs::exists(d / name), expected) << name;
+      if (!expected) continue;
+      const cv::Mat img = cv::imread((d / name).string(), cv::IMREAD_UNCHANGED);
+      EXPECT_EQ(img.size(), cv::Size(321, 241)) << name;
+      EXPECT_EQ(img.channels(), std::string(kind) == "danger" ? 1 : 3) << name;
+    }
+  }
+}
+
+TEST_F(Cli, DumpAndCsvBadPaths) {
+  std::ofstream(dir_ / "file") << "x";
+  const std::string scenario = " --scenario '" + small_scenario(2).string() + "'";
+  expect_user_error(run("run" + scenario + " --dump file"), "--dump file");
+  expect_user_error(run("run" + scenario + " --dump file/sub"), "--dump file/sub");
+  expect_user_error(run("run" + scenario + " --csv no/such/dir/m.csv"), "--csv");
+  expect_user_error(run("run" + scenario + " --csv"), "--csv");
+}
+
+TEST_F(Cli, ScaleResizesTheInputAndTheCamera) {
+  const Result r = run("run --quiet --no-timing --scenario '" + small_scenario(4).string() +
+                       "' --scale 0.5 --dump d --events e.jsonl");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("161x121"), std::string::npos) << r.out;  // 321x241 halved, rounded
+  EXPECT_EQ(read_events(dir_ / "e.jsonl").size(), 4u);
+  EXPECT_EQ(cv::imread((dir_ / "d" / "danger_000003.png").string(), cv::IMREAD_UNCHANGED).size(),
+            cv::Size(161, 121));
+  // The folder of the same scenario scales the same way.
+  const Result f = run("run --quiet --no-timing --input '" + small_folder(4).string() +
+                       "' --scale 0.5 --events f.jsonl");
+  ASSERT_EQ(f.status, 0) << f.err;
+  EXPECT_EQ(slurp(dir_ / "e.jsonl"), slurp(dir_ / "f.jsonl"));
+}
+
+TEST_F(Cli, ScaleBadValues) {
+  const std::string scenario = " --scenario '" + small_scenario(2).string() + "'";
+  for (const char* bad : {"0", "-1", "nan", "inf", "4.5", "abc", "0.1"}) {
+    const Result r = run(std::string("run") + scenario + " --scale " + bad);
+    SCOPED_TRACE(bad);
+    expect_user_error(r, "--scale");
+  }
+  expect_user_error(run("eval" + scenario + " --scale 0.5"), "--scale");  // run only
+}
+
+TEST_F(Cli, ConfigFileSetsCsvDumpAndScale) {
+  std::ofstream(dir_ / "c.yaml") << "scale: 0.5\ncsv: c.csv\ndump: cd\n";
+  const Result r =
+      run("run --quiet --config c.yaml --scenario '" + small_scenario(3).string() + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("161x121"), std::string::npos) << r.out;
+  EXPECT_EQ(read_csv(dir_ / "c.csv").size(), 4u);
+  EXPECT_TRUE(fs::exists(dir_ / "cd" / "danger_000002.png"));
+  std::ofstream(dir_ / "bad.yaml") << "scale: 0\n";
+  expect_user_error(run("run --config bad.yaml --scenario '" + small_scenario(3).string() + "'"),
+                    "scale=0");
+  std::ofstream(dir_ / "eval.yaml") << "scale: 0.5\n";
+  expect_user_error(run("eval --config eval.yaml --scenario '" + small_scenario(3).string() + "'"),
+                    "scale");
+}
+
+TEST_F(Cli, EvalWritesCsvAndDump) {
+  const Result r = run("eval --scenario '" + small_scenario(4).string() + "' --csv m.csv --dump d");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(read_csv(dir_ / "m.csv").size(), 5u);
+  EXPECT_TRUE(fs::exists(dir_ / "d" / "disparity_000003.png"));
+}
+
+/// Runs `args` with stderr (and stdout) on a pseudo-terminal through script(1); its output is
+/// everything the terminal received. Empty optional when script(1) is missing.
+std::optional<std::string> run_on_terminal(const fs::path& dir, const std::string& args) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) return std::nullopt;
+  const fs::path out = dir / "tty.txt";
+  const std::string inner = "cd '" + dir.string() + "' && '" SG_STEREOGUARD_BIN "' " + args;
+  const std::string cmd =
+      "script -qfec \"" + inner + "\" /dev/null >'" + out.string() + "' 2>&1 </dev/null";
+  if (std::system(cmd.c_str()) != 0) return std::string();
+  return slurp(out);
+}
+
+TEST_F(Cli, ProgressBarOnATerminalOnly) {
+  const std::string args = "run --scenario '" + small_scenario(6).string() + "'";
+  const std::optional<std::string> tty = run_on_terminal(dir_, args);
+  if (!tty) GTEST_SKIP() << "script(1) is not installed";
+  EXPECT_NE(tty->find("6/6 frames"), std::string::npos) << *tty;
+  EXPECT_NE(tty->find(" fps  ETA "), std::string::npos) << *tty;
+  EXPECT_NE(tty->find("\033[K"), std::string::npos) << *tty;  // erased before the summary
+  const std::optional<std::string> quiet = run_on_terminal(dir_, args + " --quiet");
+  ASSERT_TRUE(quiet);
+  EXPECT_NE(quiet->find("frames processed  6"), std::string::npos) << *quiet;
+  EXPECT_EQ(quiet->find("/6 frames"), std::string::npos) << *quiet;
+  // stderr is a file here, not a terminal: no bar.
+  const Result r = run(args);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(r.out.find("/6 frames"), std::string::npos);
 }
 
 }  // namespace

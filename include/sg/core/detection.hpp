@@ -39,6 +39,10 @@ struct Detection {
   std::vector<Obstacle> obstacles;
   double latency_ms = 0.0;              ///< acquisition to detection, ms
   cv::Mat danger;                       ///< CV_8U mask after clean-up, 255 = dangerous (for overlays)
+  /// The frame's maps, only when the run was asked to keep them (pipeline RunOptions::keep_maps,
+  /// for --dump): disparity CV_32F px (invalid < 0); backward flow CV_32FC2 px (Stereo-Flow, from
+  /// the second frame on). Empty otherwise.
+  cv::Mat disparity, flow;
 };
 
 }  // namespace sg::core

@@ -1,6 +1,7 @@
 #pragma once
 /// The YAML configuration file: mirrors the command-line flags (README "Configuration").
 #include <filesystem>
+#include <string>
 
 #include "sg/core/params.hpp"
 #include "sg/io/source_factory.hpp"
@@ -17,6 +18,9 @@ struct RunSettings {
   /// `input:` section: left, right, sbs, sbs_camera, kitti, kitti_color, euroc, camera [I, J],
   /// calib, focal_px, baseline_m, cx, cy, fps (the rate of an input without one). Flags win.
   SourceSpec input;
+  double scale = 1.0;     ///< `scale:` resize factor of the input images (run --scale)
+  std::string csv;        ///< `csv:` per-frame metrics CSV file, empty = none (--csv)
+  std::string dump;       ///< `dump:` folder of per-frame PNGs, empty = none (--dump)
 };
 
 /// Overwrites the fields of `params` (and `settings`) that the file sets; others keep their value.

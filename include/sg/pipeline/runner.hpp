@@ -30,6 +30,9 @@ struct RunOptions {
   /// so tiled flow differs from whole-image flow near the cuts and detections could differ from
   /// the sequential reference; stereo matching tiles are bit-identical and always used.
   bool tile_flow = false;
+  /// Hand each detection its disparity and flow maps (core::Detection::disparity, flow), e.g. to
+  /// dump them. Off by default: they would keep two full-size maps alive per stored detection.
+  bool keep_maps = false;
 };
 
 /// Every violation as text; empty when valid (includes core::validate of the detector params).
