@@ -31,7 +31,11 @@ void LabelJob::run(cv::Range rows) {
 }
 
 Detector::Detector(const core::DetectorParams& params, const core::Camera& camera)
-    : params_(params), camera_(camera), hysteresis_(params.signal) {
+    : params_(params),
+      camera_(camera),
+      hysteresis_(params.signal),
+      tracker_(params.signal, params.envelope.z_contact_m),
+      severity_(params.signal) {
   const std::vector<int>& gaps =
       params_.mode == core::Mode::kStereoFlow ? params_.scene_flow.gaps : params_.stereo.gaps;
   if (!gaps.empty()) max_gap_ = std::max(1, *std::max_element(gaps.begin(), gaps.end()));
@@ -113,10 +117,11 @@ core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) 
   det.danger = job.danger_;
   det.obstacles =
       extract_obstacles(det.danger, disp, job.ttc_, camera_, params_.signal, job.velocity_);
+  tracker_.update(det.time_s, det.obstacles);
   det.regions = hysteresis_.update(count_region_pixels(det.danger, params_.signal.region_columns));
   det.signal = std::any_of(det.regions.begin(), det.regions.end(),
                            [](const core::RegionSignal& r) { return r.fired; });
-  det.severity = severity_of(det.signal, det.obstacles, params_.signal);
+  det.severity = severity_.update(det.signal, severity_of(det.signal, det.obstacles, params_.signal));
   det.steering = steering_hint(det.regions);
   return det;
 }

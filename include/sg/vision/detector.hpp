@@ -18,6 +18,7 @@
 #include "sg/core/params.hpp"
 #include "sg/vision/scene_flow.hpp"
 #include "sg/vision/signals.hpp"
+#include "sg/vision/tracking.hpp"
 
 namespace sg::vision {
 
@@ -82,8 +83,9 @@ class Detector {
 
   /// Turns a labelled frame into its Detection: in Stereo-Flow mode with
   /// scene_flow.exclude_ground, dangerous pixels on or below a ground plane fitted to D_i are
-  /// cleared; then obstacles (with the mean 3D velocity in Stereo-Flow mode), region counts,
-  /// hysteresis, severity and steering. Fills frame and time_s from `frame`, danger = the cleaned
+  /// cleared; then obstacles (with the mean 3D velocity in Stereo-Flow mode) tracked over frames
+  /// with their TTC from a fit (ObstacleTracker), region counts, hysteresis, severity (held by
+  /// SeverityHold) and steering. Fills frame and time_s from `frame`, danger = the cleaned
   /// mask; leaves latency_ms to the caller. Jobs must come in the order of prepare.
   core::Detection finish(const core::StereoFrame& frame, LabelJob& job);
 
@@ -104,7 +106,9 @@ class Detector {
   core::Camera camera_;
   int max_gap_ = 1;              ///< longest gap of the active mode, camera frames
   std::deque<Past> past_;        ///< newest first (prepare only)
-  RegionHysteresis hysteresis_;  ///< finish only
+  RegionHysteresis hysteresis_;  ///< finish only (as the two below)
+  ObstacleTracker tracker_;
+  SeverityHold severity_;
 };
 
 }  // namespace sg::vision
