@@ -46,21 +46,23 @@ void print_row(const pipeline::BenchRow& r) {
             << r.dropped << "  " << pipeline::same_detections_text(r) << std::endl;
 }
 
-void write_plot(const std::string& csv, const std::string& png) {
+void write_plot(const std::string& csv, const std::string& png,
+                const std::vector<std::string>& modes) {
   const std::string script = png + ".gnuplot";
   {
     std::ofstream g(script);
     g << "set datafile separator ','\n"
       << "set terminal pngcairo size 1100,700 noenhanced\n"
       << "set output '" << png << "'\n"
-      << "set multiplot layout 1,2 title 'stereoguard bench: throughput against p99 latency, "
+      << "set multiplot layout 1," << modes.size()
+      << " title 'stereoguard bench: throughput against p99 latency, "
          "one point per configuration ("
       << csv << ")'\n"
       << "set xlabel 'p99 latency (ms)'\nset ylabel 'throughput (fps)'\nset grid\n"
       << "set key off\nset offsets graph 0.05, graph 0.25, graph 0.1, graph 0.1\n"
       << "label(k) = (k eq 'pipeline' || k eq 'paced') ? sprintf('%s W%s T%s', k, "
          "stringcolumn(5), stringcolumn(6)) : k\n";
-    for (const char* mode : {"stereo", "stereo-flow"}) {
+    for (const std::string& mode : modes) {
       g << "set title '" << mode << "'\n"
         << "plot '" << csv << "' every ::1 using (stringcolumn(2) eq '" << mode
         << "' ? $15 : NaN):12 with points pt 7 ps 1.2, '' every ::1 using (stringcolumn(2) eq '"
@@ -109,7 +111,7 @@ void bench_main(const BenchArgs& a) {
   std::cout << "csv: " << a.csv << "\n";
   if (!a.plot.empty()) {
     csv.close();
-    write_plot(a.csv, a.plot);
+    write_plot(a.csv, a.plot, a.modes);
     std::cout << "plot: " << a.plot << "\n";
   }
 }
