@@ -14,6 +14,7 @@
 #include "sg/eval/flow_metrics.hpp"
 #include "sg/io/gt_formats.hpp"
 #include "sg/io/stereo_folder.hpp"
+#include "sg/pipeline/dropping_source.hpp"
 #include "sg/pipeline/evaluation.hpp"
 #include "sg/vision/flow.hpp"
 
@@ -30,6 +31,7 @@ struct EvalArgs {
   bool flow = false;
   std::string left, right, gt, dir;
   std::string flow_methods = "all";
+  int drop_every = 0;  ///< drop every n-th frame (5 = 20 %), 0 = none
 };
 
 /// Two images and the forward GT flow from the first to the second.
@@ -185,8 +187,14 @@ void eval_main(const EvalArgs& args) {
       return pipeline::FrameTruthView{folder->truth(i), folder->truth_maps(i).danger};
     };
   }
-  const pipeline::Evaluation result = pipeline::evaluate(*in.source, truth_of, options);
-  std::cout << "eval " << in.name << " (mode " << core::to_string(options.params.mode) << ")\n"
+  if (args.drop_every < 0 || args.drop_every == 1)
+    throw core::InputError("drop-every=" + std::to_string(args.drop_every) +
+                           ": must be 0 (none) or >= 2");
+  pipeline::DroppingSource dropping(*in.source, args.drop_every);
+  const pipeline::Evaluation result = pipeline::evaluate(dropping, truth_of, options);
+  std::cout << "eval " << in.name << " (mode " << core::to_string(options.params.mode);
+  if (dropping.dropped() > 0) std::cout << ", " << dropping.dropped() << " frames dropped";
+  std::cout << ")\n"
             << result.report.table();
   if (!args.json.empty()) {
     std::ofstream out(args.json);
@@ -211,6 +219,9 @@ void add_eval_command(CLI::App& app) {
   add_input_options(*cmd, args->input);
   add_detector_options(*cmd, args->detector);
   cmd->add_option("--json", args->json, "write the metrics as JSON");
+  cmd->add_option("--drop-every", args->drop_every,
+                  "lose every n-th frame before the pipeline, as a loaded camera link does "
+                  "(5 = 20 %; default 0 = none)");
   cmd->add_flag("--flow", args->flow,
                 "optical-flow accuracy instead: EPE and bad-3px % against a forward GT .flo");
   cmd->add_option("--left", args->left, "with --flow: first image (frame 1)");
