@@ -80,6 +80,40 @@ struct IsOptional : std::false_type {};
 template <class T>
 struct IsOptional<std::optional<T>> : std::true_type {};
 
+/// Boxes the typed callbacks for run_farm; `relay` null: no second round of tasks.
+template <class EmitF, class TasksF, class RelayF, class CollectF>
+void run_typed_farm(const FarmConfig& config, EmitF& emit, TasksF& make_tasks, RelayF* relay,
+                    CollectF& collect) {
+  using Emitted = std::invoke_result_t<EmitF&>;
+  static_assert(IsOptional<Emitted>::value, "the emitter must return std::optional<Item>");
+  using Item = typename Emitted::value_type;
+  static_assert(std::is_invocable_r_v<TaskList, TasksF&, Item&>,
+                "make_tasks must be callable as TaskList(Item&)");
+  static_assert(std::is_invocable_r_v<TaskList, RelayF&, Item&>,
+                "relay must be callable as TaskList(Item&)");
+  static_assert(std::is_invocable_v<CollectF&, Item&&>, "collect must be callable with Item&&");
+  using Boxed = BoxedItem<Item>;
+
+  FarmCallbacks callbacks;
+  callbacks.emit = [&emit]() -> std::unique_ptr<FarmItem> {
+    Emitted next = emit();
+    if (!next) return nullptr;
+    return std::make_unique<Boxed>(std::move(*next));
+  };
+  callbacks.tasks = [&make_tasks](FarmItem& item) -> TaskList {
+    return make_tasks(static_cast<Boxed&>(item).value_);
+  };
+  if (relay) {
+    callbacks.relay = [relay](FarmItem& item) -> TaskList {
+      return (*relay)(static_cast<Boxed&>(item).value_);
+    };
+  }
+  callbacks.collect = [&collect](FarmItem& item) {
+    collect(std::move(static_cast<Boxed&>(item).value_));
+  };
+  run_farm(config, callbacks);
+}
+
 }  // namespace detail
 
 /// Ordered farm where each item yields several tasks that may run at once on different workers
@@ -100,27 +134,7 @@ struct IsOptional<std::optional<T>> : std::true_type {};
 template <class EmitF, class TasksF, class CollectF>
 void run_ordered_farm_tasks(const FarmConfig& config, EmitF&& emit, TasksF&& make_tasks,
                             CollectF&& collect) {
-  using Emitted = std::invoke_result_t<EmitF&>;
-  static_assert(detail::IsOptional<Emitted>::value, "the emitter must return std::optional<Item>");
-  using Item = typename Emitted::value_type;
-  static_assert(std::is_invocable_r_v<TaskList, TasksF&, Item&>,
-                "make_tasks must be callable as TaskList(Item&)");
-  static_assert(std::is_invocable_v<CollectF&, Item&&>, "collect must be callable with Item&&");
-  using Boxed = detail::BoxedItem<Item>;
-
-  detail::FarmCallbacks callbacks;
-  callbacks.emit = [&emit]() -> std::unique_ptr<detail::FarmItem> {
-    Emitted next = emit();
-    if (!next) return nullptr;
-    return std::make_unique<Boxed>(std::move(*next));
-  };
-  callbacks.tasks = [&make_tasks](detail::FarmItem& item) -> TaskList {
-    return make_tasks(static_cast<Boxed&>(item).value_);
-  };
-  callbacks.collect = [&collect](detail::FarmItem& item) {
-    collect(std::move(static_cast<Boxed&>(item).value_));
-  };
-  detail::run_farm(config, callbacks);
+  detail::run_typed_farm(config, emit, make_tasks, static_cast<TasksF*>(nullptr), collect);
 }
 
 /// Ordered farm with a second round of tasks per item, FastFlow's pipeline of farm, serial node,
@@ -138,32 +152,7 @@ void run_ordered_farm_tasks(const FarmConfig& config, EmitF&& emit, TasksF&& mak
 template <class EmitF, class TasksF, class RelayF, class CollectF>
 void run_ordered_farm_relay(const FarmConfig& config, EmitF&& emit, TasksF&& make_tasks,
                             RelayF&& relay, CollectF&& collect) {
-  using Emitted = std::invoke_result_t<EmitF&>;
-  static_assert(detail::IsOptional<Emitted>::value, "the emitter must return std::optional<Item>");
-  using Item = typename Emitted::value_type;
-  static_assert(std::is_invocable_r_v<TaskList, TasksF&, Item&>,
-                "make_tasks must be callable as TaskList(Item&)");
-  static_assert(std::is_invocable_r_v<TaskList, RelayF&, Item&>,
-                "relay must be callable as TaskList(Item&)");
-  static_assert(std::is_invocable_v<CollectF&, Item&&>, "collect must be callable with Item&&");
-  using Boxed = detail::BoxedItem<Item>;
-
-  detail::FarmCallbacks callbacks;
-  callbacks.emit = [&emit]() -> std::unique_ptr<detail::FarmItem> {
-    Emitted next = emit();
-    if (!next) return nullptr;
-    return std::make_unique<Boxed>(std::move(*next));
-  };
-  callbacks.tasks = [&make_tasks](detail::FarmItem& item) -> TaskList {
-    return make_tasks(static_cast<Boxed&>(item).value_);
-  };
-  callbacks.relay = [&relay](detail::FarmItem& item) -> TaskList {
-    return relay(static_cast<Boxed&>(item).value_);
-  };
-  callbacks.collect = [&collect](detail::FarmItem& item) {
-    collect(std::move(static_cast<Boxed&>(item).value_));
-  };
-  detail::run_farm(config, callbacks);
+  detail::run_typed_farm(config, emit, make_tasks, &relay, collect);
 }
 
 /// Ordered farm with one task per item: `emit()` -> std::optional<In>, `work(In&&)` -> Mid run by
