@@ -51,8 +51,8 @@ void DetectionEvaluator::add(const core::Detection& detection, const core::Frame
       if (!o.ttc_s) continue;
       const double score = gt_danger.empty()
                                ? -*o.ttc_s
-                               : cv::countNonZero(gt_danger(o.bbox & cv::Rect(0, 0, gt_danger.cols,
-                                                                            gt_danger.rows)));
+                               : cv::countNonZero(gt_danger(
+                                     o.bbox & cv::Rect(0, 0, gt_danger.cols, gt_danger.rows)));
       if (!best || score > best_score) best = &o, best_score = score;
     }
     if (best) ttc_errors_.push_back(std::abs(*best->ttc_s - *gt->ttc_s) / *gt->ttc_s);
@@ -96,7 +96,9 @@ DetectionReport DetectionEvaluator::report() const {
 }
 
 nlohmann::json DetectionReport::to_json() const {
-  auto opt = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); };
+  auto opt = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json();
+  };
   nlohmann::json lead = nlohmann::json::array();
   for (const auto& [id, t] : lead_times_s) {
     lead.push_back({{"id", id}, {"lead_time_s", t ? nlohmann::json(*t) : nlohmann::json()}});

@@ -121,7 +121,8 @@ core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) 
   det.regions = hysteresis_.update(count_region_pixels(det.danger, params_.signal.region_columns));
   det.signal = std::any_of(det.regions.begin(), det.regions.end(),
                            [](const core::RegionSignal& r) { return r.fired; });
-  det.severity = severity_.update(det.signal, severity_of(det.signal, det.obstacles, params_.signal));
+  det.severity =
+      severity_.update(det.signal, severity_of(det.signal, det.obstacles, params_.signal));
   det.steering = steering_hint(det.regions);
   return det;
 }
