@@ -379,18 +379,29 @@ cv::Mat random_flow(cv::Size size, double amplitude, cv::RNG& rng) {
   return big(cv::Rect(2, 1, size.width, size.height));
 }
 
-void compare_with_naive(const std::vector<int>& gaps, int history, uint64_t seed,
-                        bool longest = false) {
+/// The small odd camera and wide envelope of the random-map comparisons.
+core::Camera random_map_camera() {
   core::Camera cam = odd_camera();
   cam.width = 63;
   cam.height = 49;
   cam.cx = 31.2;
   cam.cy = 24.6;
-  const cv::Size size(cam.width, cam.height);
+  return cam;
+}
+
+core::Envelope random_map_envelope() {
   core::Envelope env;
   env.half_width_m = 1.5;
   env.y_top_m = -1.5;
   env.y_bottom_m = 1.5;
+  return env;
+}
+
+void compare_with_naive(const std::vector<int>& gaps, int history, uint64_t seed,
+                        bool longest = false) {
+  const core::Camera cam = random_map_camera();
+  const cv::Size size(cam.width, cam.height);
+  const core::Envelope env = random_map_envelope();
   SceneFlowParams p = plain();
   p.longest_gap_decides = longest;
   p.z_max_m = 2.0;  // some of the random points (0.67 .. 2.5 m) lie beyond
@@ -452,16 +463,9 @@ TEST(LabelStereoFlowWindow, MatchesNaiveReferenceOnRandomMaps) {
 // The pipeline runs the labelling in row bands on the farm: bands stitched must equal the whole
 // image bit for bit (the whole-image call is itself checked against the naive reference above).
 TEST(LabelStereoFlowRows, BandsStitchedEqualTheWholeImage) {
-  core::Camera cam = odd_camera();
-  cam.width = 63;
-  cam.height = 49;
-  cam.cx = 31.2;
-  cam.cy = 24.6;
+  const core::Camera cam = random_map_camera();
   const cv::Size size(cam.width, cam.height);
-  core::Envelope env;
-  env.half_width_m = 1.5;
-  env.y_top_m = -1.5;
-  env.y_bottom_m = 1.5;
+  const core::Envelope env = random_map_envelope();
   for (bool longest : {false, true}) {
     SceneFlowParams p = plain();
     p.longest_gap_decides = longest;
