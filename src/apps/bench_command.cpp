@@ -35,28 +35,36 @@ void print_row(const pipeline::BenchRow& r) {
             << r.resolution.height << std::right << std::setw(3) << r.workers << std::setw(4)
             << r.tiles << std::setw(4) << r.tokens << std::fixed << std::setprecision(1)
             << std::setw(8) << r.pace_fps << std::setw(8) << r.fps << std::setprecision(2)
-            << std::setw(8) << r.speedup << std::setprecision(1) << std::setw(8)
-            << r.latency_p50_ms << std::setw(8) << r.latency_p99_ms << std::setw(7) << r.dropped
-            << "  " << pipeline::same_detections_text(r) << std::endl;
+            << std::setw(8) << r.speedup << std::setw(8) << r.speedup_1t << std::setprecision(1)
+            << std::setw(8) << r.latency_p50_ms << std::setw(8) << r.latency_p99_ms << std::setw(7)
+            << r.dropped << "  " << pipeline::same_detections_text(r) << std::endl;
 }
 
-void write_plot(const std::string& csv, const std::string& png) {
+void write_plot(const std::string& csv, const std::string& png,
+                const std::vector<std::string>& modes) {
   const std::string script = png + ".gnuplot";
   {
     std::ofstream g(script);
     g << "set datafile separator ','\n"
       << "set terminal pngcairo size 1100,700 noenhanced\n"
       << "set output '" << png << "'\n"
-      << "set multiplot layout 2,1 title 'stereoguard bench (" << csv << ")'\n"
-      << "set style data histograms\nset style fill solid 0.8\nset xtics rotate by -45 font ',8'\n"
-      << "set ylabel 'throughput (fps)'\n"
-      << "plot '" << csv << "' every ::1 using 12:xtic(stringcolumn(1).' '.stringcolumn(2)."
-         "' '.stringcolumn(3).' W'.stringcolumn(5).' T'.stringcolumn(6)) title 'fps'\n"
-      << "set ylabel 'latency (ms)'\n"
-      << "plot '" << csv << "' every ::1 using 14:xtic(stringcolumn(1).' '.stringcolumn(2)."
-         "' '.stringcolumn(3).' W'.stringcolumn(5).' T'.stringcolumn(6)) title 'p50', "
-         "'' every ::1 using 15 title 'p99'\n"
-      << "unset multiplot\n";
+      << "set multiplot layout 1," << modes.size()
+      << " title 'stereoguard bench: throughput against p99 latency, "
+         "one point per configuration ("
+      << csv << ")'\n"
+      << "set xlabel 'p99 latency (ms)'\nset ylabel 'throughput (fps)'\nset grid\n"
+      << "set key off\nset offsets graph 0.05, graph 0.25, graph 0.1, graph 0.1\n"
+      << "label(k) = (k eq 'pipeline' || k eq 'paced') ? sprintf('%s W%s T%s', k, "
+         "stringcolumn(5), stringcolumn(6)) : k\n";
+    for (const std::string& mode : modes) {
+      g << "set title '" << mode << "'\n"
+        << "plot '" << csv << "' every ::1 using (stringcolumn(2) eq '" << mode
+        << "' ? $15 : NaN):12 with points pt 7 ps 1.2, '' every ::1 using (stringcolumn(2) eq '"
+        << mode
+        << "' ? $15 : NaN):12:(label(stringcolumn(1)).' '.stringcolumn(3).'x'"
+           ".stringcolumn(4)) with labels offset 0.5,0.6 left font ',7'\n";
+    }
+    g << "unset multiplot\n";
   }
   const std::string cmd = "gnuplot '" + script + "'";
   if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
@@ -94,8 +102,10 @@ void bench_main(const BenchArgs& a) {
                                              : "scenario " + a.scenario + " (rendered once)";
   std::cout << "stereoguard bench: " << what << ", " << a.frames
             << " frames per configuration held in memory\n"
-            << "kind     mode          resolution  W   T tok  pace/s     fps speedup"
-               "     p50     p99   drop  same\n";
+            << "kind     mode          resolution  W   T tok  pace/s     fps  vs-mt   vs-1t"
+               "     p50     p99   drop  same\n"
+            << "(vs-mt: speedup against the plain loop with OpenCV's threads, the default a user "
+               "gets; vs-1t: against the same loop on one thread)\n";
   pipeline::run_bench(config, [&](const pipeline::BenchRow& row) {
     print_row(row);
     csv << pipeline::to_csv(row) << "\n" << std::flush;
@@ -103,7 +113,7 @@ void bench_main(const BenchArgs& a) {
   std::cout << "csv: " << a.csv << "\n";
   if (!a.plot.empty()) {
     csv.close();
-    write_plot(a.csv, a.plot);
+    write_plot(a.csv, a.plot, a.modes);
     std::cout << "plot: " << a.plot << "\n";
   }
 }

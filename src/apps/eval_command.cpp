@@ -16,6 +16,7 @@
 #include "sg/eval/flow_metrics.hpp"
 #include "sg/io/gt_formats.hpp"
 #include "sg/io/stereo_folder.hpp"
+#include "sg/pipeline/dropping_source.hpp"
 #include "sg/pipeline/evaluation.hpp"
 #include "sg/vision/flow.hpp"
 
@@ -38,6 +39,7 @@ struct EvalArgs {
   bool stereo = false;
   double gt_scale = 0;
   std::string matchers = "bm,sgbm,fast,fast-census";
+  int drop_every = 0;  ///< drop every n-th frame (5 = 20 %), 0 = none
 };
 
 /// Two images and the forward GT flow from the first to the second.
@@ -221,14 +223,20 @@ void eval_main(const EvalArgs& args) {
       return pipeline::FrameTruthView{folder->truth(i), folder->truth_maps(i).danger};
     };
   }
+  if (args.drop_every < 0 || args.drop_every == 1)
+    throw core::InputError("drop-every=" + std::to_string(args.drop_every) +
+                           ": must be 0 (none) or >= 2");
+  pipeline::DroppingSource dropping(*in.source, args.drop_every);
   FrameOutputs frame_outputs(outputs, true, !args.quiet && io::stderr_is_terminal(),
                              in.source->size(),
                              options.params.bm.min_disparity + options.params.bm.num_disparities);
   const pipeline::Evaluation result = pipeline::evaluate(
-      *in.source, truth_of, options,
+      dropping, truth_of, options,
       [&](const core::StereoFrame&, const core::Detection& d) { frame_outputs.write(d); });
   frame_outputs.clear_progress();
-  std::cout << "eval " << in.name << " (mode " << core::to_string(options.params.mode) << ")\n"
+  std::cout << "eval " << in.name << " (mode " << core::to_string(options.params.mode);
+  if (dropping.dropped() > 0) std::cout << ", " << dropping.dropped() << " frames dropped";
+  std::cout << ")\n"
             << result.report.table();
   if (!args.json.empty()) {
     std::ofstream out(args.json);
@@ -256,6 +264,9 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--json", args->json, "write the metrics as JSON");
   add_output_options(*cmd, args->outputs, /*with_scale=*/false);
   cmd->add_flag("--quiet", args->quiet, "no progress bar (shown only when stderr is a terminal)");
+  cmd->add_option("--drop-every", args->drop_every,
+                  "lose every n-th frame before the pipeline, as a loaded camera link does "
+                  "(5 = 20 %; default 0 = none)");
   auto* flow_flag = cmd->add_flag("--flow", args->flow,
                 "optical-flow accuracy instead: EPE and bad-3px % against a forward GT .flo");
   cmd->add_option("--left", args->left,

@@ -124,6 +124,15 @@ std::vector<std::string> validate(const SignalParams& p) {
   c.require(finite_positive(p.ttc_danger_s), "ttc_danger_s", p.ttc_danger_s, "must be > 0");
   c.require(std::isfinite(p.ttc_warning_s) && p.ttc_warning_s >= p.ttc_danger_s, "ttc_warning_s",
             p.ttc_warning_s, "must be >= ttc_danger_s");
+  c.require(std::isfinite(p.track_min_overlap) && p.track_min_overlap > 0 &&
+                p.track_min_overlap <= 1,
+            "track_min_overlap", p.track_min_overlap, "must be in (0, 1]");
+  c.require(finite_positive(p.ttc_fit_window_s), "ttc_fit_window_s", p.ttc_fit_window_s,
+            "must be > 0");
+  c.require(p.ttc_fit_min_frames >= 2, "ttc_fit_min_frames", p.ttc_fit_min_frames,
+            "must be >= 2");
+  c.require(p.severity_off_frames >= 1, "severity_off_frames", p.severity_off_frames,
+            "must be >= 1");
   return out;
 }
 

@@ -1,5 +1,6 @@
 #include "sg/eval/detection_metrics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -38,6 +39,26 @@ void DetectionEvaluator::add(const core::Detection& detection, const core::Frame
     auto [it, inserted] = lead_.try_emplace(o.id, std::nullopt);
     if (!it->second && truth.alarm && fired) it->second = o.ttc_s.value_or(0.0);
   }
+  // TTC accuracy: the colliding obstacle nearest to contact against the detected obstacle that
+  // covers most of the GT danger mask (the one with the smallest TTC without a mask).
+  const core::ObstacleTruth* gt = nullptr;
+  for (const auto& o : truth.obstacles)
+    if (o.colliding && o.ttc_s && *o.ttc_s > 0 && (!gt || *o.ttc_s < *gt->ttc_s)) gt = &o;
+  if (truth.alarm && gt) {
+    const core::Obstacle* best = nullptr;
+    double best_score = -1;
+    for (const auto& o : detection.obstacles) {
+      if (!o.ttc_s) continue;
+      const double score = gt_danger.empty()
+                               ? -*o.ttc_s
+                               : cv::countNonZero(gt_danger(
+                                     o.bbox & cv::Rect(0, 0, gt_danger.cols, gt_danger.rows)));
+      if (!best || score > best_score) best = &o, best_score = score;
+    }
+    if (best) ttc_errors_.push_back(std::abs(*best->ttc_s - *gt->ttc_s) / *gt->ttc_s);
+  }
+  if (frames_ > 1 && detection.severity != last_severity_) ++severity_changes_;
+  last_severity_ = detection.severity;
   if (!gt_danger.empty() && !detection.danger.empty()) {
     CV_Assert(gt_danger.size() == detection.danger.size());
     cv::Mat gt = gt_danger > 0, det = detection.danger > 0;
@@ -59,10 +80,25 @@ DetectionReport DetectionEvaluator::report() const {
   r.lead_times_s = lead_;
   r.danger_iou = uni_ == 0 ? 1.0 : static_cast<double>(inter_) / static_cast<double>(uni_);
   r.first_alarm_frame = first_alarm_;
+  r.ttc_frames = static_cast<int>(ttc_errors_.size());
+  if (!ttc_errors_.empty()) {
+    std::vector<double> e = ttc_errors_;
+    std::sort(e.begin(), e.end());
+    auto at = [&e](double q) {  // nearest rank
+      const size_t i = static_cast<size_t>(std::ceil(q * e.size())) - 1;
+      return e[std::min(i, e.size() - 1)];
+    };
+    r.ttc_rel_error_median = at(0.5);
+    r.ttc_rel_error_p90 = at(0.9);
+  }
+  r.severity_changes = severity_changes_;
   return r;
 }
 
 nlohmann::json DetectionReport::to_json() const {
+  auto opt = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json();
+  };
   nlohmann::json lead = nlohmann::json::array();
   for (const auto& [id, t] : lead_times_s) {
     lead.push_back({{"id", id}, {"lead_time_s", t ? nlohmann::json(*t) : nlohmann::json()}});
@@ -77,6 +113,10 @@ nlohmann::json DetectionReport::to_json() const {
           {"false_alarm_rate", false_alarm_rate},
           {"lead_times_s", lead},
           {"danger_iou", danger_iou},
+          {"ttc_frames", ttc_frames},
+          {"ttc_rel_error_median", opt(ttc_rel_error_median)},
+          {"ttc_rel_error_p90", opt(ttc_rel_error_p90)},
+          {"severity_changes", severity_changes},
           {"first_alarm_frame",
            first_alarm_frame ? nlohmann::json(*first_alarm_frame) : nlohmann::json()}};
 }
@@ -92,6 +132,11 @@ std::string DetectionReport::table() const {
     << "  recall settled    " << recall_settled << "\n"
     << "  false alarm rate  " << false_alarm_rate << "\n"
     << "  danger IoU        " << danger_iou << "\n";
+  if (ttc_rel_error_median) {
+    s << "  TTC rel. error    median " << *ttc_rel_error_median << "  p90 " << *ttc_rel_error_p90
+      << " (" << ttc_frames << " frames)\n";
+  }
+  s << "  severity changes  " << severity_changes << "\n";
   s << std::setprecision(2);
   for (const auto& [id, t] : lead_times_s) {
     s << "  lead time id " << id << "    ";

@@ -138,6 +138,10 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("off_m", p.signal.off_m)
         .field("ttc_danger_s", p.signal.ttc_danger_s)
         .field("ttc_warning_s", p.signal.ttc_warning_s)
+        .field("track_min_overlap", p.signal.track_min_overlap)
+        .field("ttc_fit_window_s", p.signal.ttc_fit_window_s)
+        .field("ttc_fit_min_frames", p.signal.ttc_fit_min_frames)
+        .field("severity_off_frames", p.signal.severity_off_frames)
         .done();
     std::string method = core::to_string(p.flow.method);
     Section(root["flow"], "flow")

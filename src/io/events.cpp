@@ -39,6 +39,8 @@ nlohmann::json detection_to_json(const core::Detection& d, bool timing) {
       const cv::Vec3d& v = *o.velocity;
       e["velocity_mps"] = {rounded(v[0], 4), rounded(v[1], 4), rounded(v[2], 4)};
     }
+    if (o.track_id > 0) e["id"] = o.track_id;
+    if (o.closing_speed_mps) e["closing_speed_mps"] = rounded(*o.closing_speed_mps, 4);
     j["obstacles"].push_back(std::move(e));
   }
   if (timing) j["latency_ms"] = rounded(d.latency_ms, 3);

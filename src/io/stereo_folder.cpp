@@ -266,24 +266,47 @@ FolderSource::FolderSource(const fs::path& dir) : dir_(dir) {
   }
 }
 
-std::optional<core::StereoFrame> FolderSource::next() {
-  if (next_index_ >= size()) return std::nullopt;
-  // Advance first: a broken frame is reported once, and a caller that goes on gets the next one.
-  const int i = next_index_++;
+namespace {
+
+/// Decodes one pair of a stereo folder and checks it against the first frame's size.
+core::StereoFrame load_pair(int index, double time_s, const fs::path& left, const fs::path& right,
+                            cv::Size expected) {
   core::StereoFrame frame;
-  frame.index = i;
-  frame.time_s = i / camera_.fps;
-  frame.left = load_gray(left_[i]);
-  frame.right = load_gray(right_[i]);
-  const cv::Size expected(camera_.width, camera_.height);
+  frame.index = index;
+  frame.time_s = time_s;
+  frame.left = load_gray(left);
+  frame.right = load_gray(right);
   for (const auto* side : {&frame.left, &frame.right}) {
     if (side->size() != expected) {
-      const fs::path& file = side == &frame.left ? left_[i] : right_[i];
+      const fs::path& file = side == &frame.left ? left : right;
       throw core::InputError("size mismatch: " + file.string() + " is " + size_text(side->size()) +
                              ", the first frame is " + size_text(expected));
     }
   }
   return frame;
+}
+
+}  // namespace
+
+std::optional<core::StereoFrame> FolderSource::next() {
+  std::optional<core::PendingFrame> pending = next_pending();
+  if (!pending) return std::nullopt;
+  return pending->load();
+}
+
+std::optional<core::PendingFrame> FolderSource::next_pending() {
+  if (next_index_ >= size()) return std::nullopt;
+  // Advance first: a broken frame is reported once, and a caller that goes on gets the next one.
+  const int i = next_index_++;
+  core::PendingFrame pending;
+  pending.index = i;
+  pending.time_s = i / camera_.fps;
+  // The load copies what it needs, so it may run on any thread after the source moved on.
+  pending.load = [i, time_s = pending.time_s, left = left_[i], right = right_[i],
+                  expected = cv::Size(camera_.width, camera_.height)] {
+    return load_pair(i, time_s, left, right, expected);
+  };
+  return pending;
 }
 
 bool FolderSource::has_truth() const { return has_truth_; }

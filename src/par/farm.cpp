@@ -1,13 +1,13 @@
 #include "sg/par/farm.hpp"
 
+#include <oneapi/tbb/flow_graph.h>
+#include <oneapi/tbb/task_arena.h>
+
 #include <atomic>
 #include <cstddef>
 #include <mutex>
 #include <stdexcept>
 #include <tuple>
-
-#include <oneapi/tbb/flow_graph.h>
-#include <oneapi/tbb/task_arena.h>
 
 namespace sg::par {
 
@@ -56,6 +56,9 @@ class HandoffScope {
 void run_sequential(const FarmCallbacks& cb) {
   while (std::unique_ptr<FarmItem> item = cb.emit()) {
     for (const std::function<void()>& task : cb.tasks(*item)) task();
+    if (cb.relay) {
+      for (const std::function<void()>& task : cb.relay(*item)) task();
+    }
     cb.collect(*item);
   }
 }
@@ -71,12 +74,14 @@ struct Slot {
   std::size_t seq = 0;                    // emission index, the sequencer's key
   std::atomic<std::size_t> published{0};  // seq + 1 once the emitter filled the slot
   std::atomic<std::size_t> remaining{0};  // tasks not yet finished
+  std::atomic<std::size_t> relayed{0};    // seq + 1 once the relay replaced the tasks
   std::atomic<bool> free{true};
 };
 
 struct TaskMsg {
   std::size_t seq = 0;
   std::size_t task = 0;
+  int phase = 0;  // 0: the emitter's tasks, 1: the relay's
 };
 
 void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
@@ -88,6 +93,7 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   // Uncontended locks (the nodes are serial already). They make the order between consecutive
   // emitter (collector) calls on different threads visible to ThreadSanitizer.
   std::mutex emit_mutex;
+  std::mutex relay_mutex;
   std::mutex collect_mutex;
 
   flow::graph graph;
@@ -136,14 +142,17 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
     for (std::size_t i = 0; i < n; ++i) std::get<0>(ports).try_put(TaskMsg{seq, i});
   });
 
-  using FarmNode = flow::multifunction_node<TaskMsg, std::tuple<std::size_t>>;
+  // Port 0: the item's first tasks are done (to the relay, or to the collector without one);
+  // port 1: its relay tasks are done (to the collector).
+  using FarmNode = flow::multifunction_node<TaskMsg, std::tuple<std::size_t, std::size_t>>;
   FarmNode farm(graph, static_cast<std::size_t>(config.workers),
                 [&](const TaskMsg& msg, FarmNode::output_ports_type& ports) {
                   HandoffScope scope;
                   Slot& slot = slot_of(msg.seq);
-                  // Only the emitter writes `published`, so tasks of one item are not ordered
-                  // with each other (for TSan either): they may run at once.
+                  // Only the emitter writes `published` (the relay `relayed`), so tasks of one
+                  // item are not ordered with each other (for TSan either): they may run at once.
                   (void)slot.published.load(std::memory_order_acquire);
+                  if (msg.phase == 1) (void)slot.relayed.load(std::memory_order_acquire);
                   // Isolated so that a worker waiting in a nested parallel_for (tiles, OpenCV)
                   // only helps with its own task instead of picking up another item's task,
                   // which would delay this item behind an unrelated one.
@@ -151,18 +160,45 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
                   if (slot.remaining.fetch_sub(1, std::memory_order_release) == 1) {
                     // The last task sees every task's writes before passing the item on.
                     (void)slot.remaining.load(std::memory_order_acquire);
-                    std::get<0>(ports).try_put(msg.seq);
+                    if (msg.phase == 0) {
+                      std::get<0>(ports).try_put(msg.seq);
+                    } else {
+                      std::get<1>(ports).try_put(msg.seq);
+                    }
                   }
                 });
 
   flow::sequencer_node<std::size_t> sequencer(graph, [](std::size_t seq) { return seq; });
+  flow::sequencer_node<std::size_t> relay_sequencer(graph, [](std::size_t seq) { return seq; });
+
+  using RelayNode = flow::multifunction_node<std::size_t, std::tuple<TaskMsg, std::size_t>>;
+  RelayNode relay(graph, flow::serial, [&](std::size_t seq, RelayNode::output_ports_type& ports) {
+    HandoffScope scope;
+    Slot& slot = slot_of(seq);
+    (void)slot.published.load(std::memory_order_acquire);
+    (void)slot.remaining.load(std::memory_order_acquire);
+    std::size_t n = 0;
+    {
+      std::lock_guard<std::mutex> lock(relay_mutex);
+      slot.tasks = cb.relay(*slot.item);
+      n = slot.tasks.size();
+      slot.remaining.store(n, std::memory_order_relaxed);
+      slot.relayed.store(seq + 1, std::memory_order_release);
+    }
+    if (n == 0) {
+      std::get<1>(ports).try_put(seq);
+      return;
+    }
+    for (std::size_t i = 0; i < n; ++i) std::get<0>(ports).try_put(TaskMsg{seq, i, 1});
+  });
 
   flow::function_node<std::size_t, flow::continue_msg> collect(
       graph, flow::serial, [&](std::size_t seq) {
         HandoffScope scope;
         Slot& slot = slot_of(seq);
         (void)slot.published.load(std::memory_order_acquire);  // items without tasks
-        (void)slot.remaining.load(std::memory_order_acquire);   // every task's writes
+        (void)slot.remaining.load(std::memory_order_acquire);  // every task's writes
+        (void)slot.relayed.load(std::memory_order_acquire);    // items without relay tasks
         {
           std::lock_guard<std::mutex> lock(collect_mutex);
           cb.collect(*slot.item);
@@ -177,8 +213,18 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   flow::make_edge(ticks, limiter);
   flow::make_edge(limiter, emit);
   flow::make_edge(flow::output_port<0>(emit), farm);
-  flow::make_edge(flow::output_port<1>(emit), sequencer);
-  flow::make_edge(flow::output_port<0>(farm), sequencer);
+  if (cb.relay) {
+    // Items without first tasks go through the relay too.
+    flow::make_edge(flow::output_port<1>(emit), relay_sequencer);
+    flow::make_edge(flow::output_port<0>(farm), relay_sequencer);
+    flow::make_edge(relay_sequencer, relay);
+    flow::make_edge(flow::output_port<0>(relay), farm);
+    flow::make_edge(flow::output_port<1>(relay), sequencer);
+    flow::make_edge(flow::output_port<1>(farm), sequencer);
+  } else {
+    flow::make_edge(flow::output_port<1>(emit), sequencer);
+    flow::make_edge(flow::output_port<0>(farm), sequencer);
+  }
   flow::make_edge(sequencer, collect);
 
   handoff_start();

@@ -1,7 +1,11 @@
 #include "sg/pipeline/runner.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <memory>
+#include <mutex>
+#include <numeric>
 #include <sstream>
 #include <thread>
 
@@ -16,41 +20,79 @@
 namespace sg::pipeline {
 namespace {
 
-/// One frame travelling through the farm.
-struct FrameJob {
-  core::StereoFrame frame;
-  cv::Mat previous_left;  ///< L_{i-1} for the flow task; empty for the first frame
-  vision::FrameMaps maps;
-  par::TimePoint acquired;
-  double sm_ms = 0.0, of_ms = 0.0;
+/// A frame read and stamped by the emitter, decoded by whichever farm task needs it first (the
+/// frame's own tasks, or the flow task of the next frame, which needs this left image): once,
+/// off the emitter. A failed decode throws to every caller.
+class LazyFrame {
+ public:
+  explicit LazyFrame(core::PendingFrame pending) : pending_(std::move(pending)) {
+    header_.index = pending_.index;
+    header_.time_s = pending_.time_s;
+  }
+  /// The decoded, checked frame; decodes on the first call (thread-safe).
+  const core::StereoFrame& get() {
+    std::call_once(once_, [this] {
+      const par::Stopwatch watch;
+      core::StereoFrame frame = pending_.load();
+      frame.index = pending_.index;
+      frame.time_s = pending_.time_s;
+      vision::check_frame(frame);
+      frame_ = std::move(frame);
+      pending_.load = nullptr;  // frees what the load captured
+      decode_ms_ = watch.elapsed_ms();
+    });
+    return frame_;
+  }
+  /// Index and time only, known without decoding.
+  const core::StereoFrame& header() const { return header_; }
+  /// Time the decode took, ms (0 before it ran).
+  double decode_ms() const { return decode_ms_; }
+
+ private:
+  std::once_flag once_;
+  core::PendingFrame pending_;
+  core::StereoFrame header_, frame_;
+  double decode_ms_ = 0.0;
 };
 
-/// The emitter: reads frames, paces them like a camera and drops what a camera would overwrite.
-/// A paced frame is "acquired" at its capture time, so its latency includes any wait for a token.
+/// One frame travelling through the farm.
+struct FrameJob {
+  std::shared_ptr<LazyFrame> frame;
+  std::shared_ptr<LazyFrame> previous;  ///< the frame emitted before, for the flow; null at first
+  vision::FrameMaps maps;
+  vision::LabelJob label;
+  cv::Mat kept_disparity, kept_flow;  ///< shares of the maps for the sink (RunOptions::keep_maps)
+  par::TimePoint acquired;
+  double sm_ms = 0.0, of_ms = 0.0;
+  std::vector<double> label_ms;  ///< one per labelling tile
+};
+
+/// The emitter: reads frames (decoding is left to the farm), paces them like a camera and drops
+/// what a camera would overwrite, without decoding it. A paced frame is "acquired" at its capture
+/// time, so its latency includes any wait for a token.
 class Emitter {
  public:
   Emitter(core::FrameSource& source, double pace_fps) : source_(source), pace_fps_(pace_fps) {}
 
   std::optional<FrameJob> operator()() {
     const par::TimePoint begin = par::now();
-    std::optional<core::StereoFrame> frame = source_.next();
+    std::optional<core::PendingFrame> frame = source_.next_pending();
     if (!frame) return std::nullopt;
     if (pace_fps_ > 0) {
       // A camera overwrites a frame nobody took before the next one arrived: while the successor
       // of this frame has been captured already, this frame is lost (dropped) and the successor
       // takes its place. The last frame of a stream has no successor and is never dropped.
       while (capture_time(emitted_ + dropped_ + 1) <= par::now()) {
-        std::optional<core::StereoFrame> successor = source_.next();
+        std::optional<core::PendingFrame> successor = source_.next_pending();
         if (!successor) break;
         ++dropped_;
         frame = std::move(successor);
       }
     }
-    vision::check_frame(*frame);
     FrameJob job;
-    job.previous_left = previous_left_;
-    previous_left_ = frame->left;
-    job.frame = std::move(*frame);
+    job.frame = std::make_shared<LazyFrame>(std::move(*frame));
+    job.previous = previous_;
+    previous_ = job.frame;
     busy_ms_ += par::elapsed_ms(begin);
     if (pace_fps_ > 0) {
       job.acquired = capture_time(emitted_ + dropped_);
@@ -76,7 +118,7 @@ class Emitter {
   core::FrameSource& source_;
   double pace_fps_;
   par::TimePoint t0_;
-  cv::Mat previous_left_;
+  std::shared_ptr<LazyFrame> previous_;
   int emitted_ = 0, dropped_ = 0;
   double busy_ms_ = 0.0;
 };
@@ -92,26 +134,62 @@ void tiled(int rows_total, int tiles, Kernel&& kernel) {
                           [&](int, int begin, int end) { kernel(cv::Range(begin, end)); });
 }
 
-/// The farm's tasks for one frame: SM always, OF in Stereo-Flow mode from the second frame on.
+/// The farm's first tasks for one frame: SM always (it decodes the frame), OF in Stereo-Flow mode
+/// from the second frame on (it needs this frame's and the previous frame's left image).
 par::TaskList make_tasks(FrameJob& job, const RunOptions& o) {
-  const bool with_flow = o.params.mode == core::Mode::kStereoFlow && !job.previous_left.empty();
-  vision::allocate_maps(job.frame.left.size(), with_flow, job.maps.disparity, job.maps.flow);
+  const bool flow_mode = o.params.mode == core::Mode::kStereoFlow;
+  const bool with_flow = flow_mode && job.previous;
   par::TaskList tasks;
-  tasks.emplace_back([&job, &o] {
+  tasks.emplace_back([&job, &o, flow_mode] {
+    const core::StereoFrame& frame = job.frame->get();
     const par::Stopwatch watch;
-    tiled(job.frame.left.rows, o.tiles, [&](cv::Range rows) {
-      vision::disparity_rows(job.frame, o.params, job.maps.disparity, rows);
+    vision::allocate_maps(frame.left.size(), false, job.maps.disparity, job.maps.flow);
+    tiled(frame.left.rows, o.tiles, [&](cv::Range rows) {
+      vision::disparity_rows(frame, o.params, job.maps.disparity, rows);
     });
     vision::disparity_finish(o.params, job.maps.disparity);
+    if (flow_mode) vision::depth_edges(o.params, job.maps.disparity, job.maps.edges);
     job.sm_ms = watch.elapsed_ms();
   });
   if (with_flow) {
     tasks.emplace_back([&job, &o] {
+      const cv::Mat& current = job.frame->get().left;
+      const cv::Mat& previous = job.previous->get().left;
       const par::Stopwatch watch;
-      tiled(job.frame.left.rows, o.tile_flow ? o.tiles : 1, [&](cv::Range rows) {
-        vision::flow_rows(job.frame.left, job.previous_left, o.params, job.maps.flow, rows);
+      job.maps.flow.create(current.size(), CV_32FC2);
+      tiled(current.rows, o.tile_flow ? o.tiles : 1, [&](cv::Range rows) {
+        vision::flow_rows(current, previous, o.params, job.maps.flow, rows);
       });
       job.of_ms = watch.elapsed_ms();
+    });
+  }
+  return tasks;
+}
+
+/// The relay (serial, in frame order): the detector records the frame's maps in its history and
+/// hands back the frame's labelling, which the farm runs in row bands (max(W, T) of them).
+par::TaskList relay_tasks(FrameJob& job, vision::Detector& detector, const RunOptions& o) {
+  // The previous frame is decoded (its own first task did it) and no longer needed here.
+  job.previous.reset();
+  if (o.keep_maps) {
+    job.kept_disparity = job.maps.disparity;
+    job.kept_flow = job.maps.flow;
+  }
+  job.label = detector.prepare(job.frame->header(), std::move(job.maps));
+  const int bands =
+      job.label.tileable() ? par::tile_count(job.label.rows(), std::max(o.workers, o.tiles)) : 1;
+  job.label_ms.assign(static_cast<size_t>(bands), 0.0);
+  par::TaskList tasks;
+  for (int b = 0; b < bands; ++b) {
+    tasks.emplace_back([&job, b, bands] {
+      const par::Stopwatch watch;
+      if (bands == 1) {
+        job.label.run(cv::Range::all());
+      } else {
+        const par::RowRange r = par::tile_rows(job.label.rows(), bands, b);
+        job.label.run(cv::Range(r.begin, r.end));
+      }
+      job.label_ms[static_cast<size_t>(b)] = watch.elapsed_ms();
     });
   }
   return tasks;
@@ -161,8 +239,8 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   s.pace_fps = options.pace_fps;
 
   par::FarmConfig farm;
-  farm.backend = options.workers == 1 && options.tiles == 1 ? par::Backend::kSequential
-                                                             : par::Backend::kTbb;
+  farm.backend =
+      options.workers == 1 && options.tiles == 1 ? par::Backend::kSequential : par::Backend::kTbb;
   farm.workers = options.workers;
   farm.tokens = s.tokens;
   farm.threads = options.threads;
@@ -177,10 +255,11 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
 
   auto collect = [&](FrameJob&& job) {
     const par::Stopwatch watch;
-    core::Detection detection = detector.process(job.frame, job.maps);
+    const core::StereoFrame& frame = job.frame->get();
+    core::Detection detection = detector.finish(frame, job.label);
     if (options.keep_maps) {
-      detection.disparity = job.maps.disparity;
-      detection.flow = job.maps.flow;
+      detection.disparity = job.kept_disparity;
+      detection.flow = job.kept_flow;
     }
     const par::TimePoint done = par::now();
     detection.latency_ms = par::elapsed_ms(job.acquired, done);
@@ -196,17 +275,21 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
         s.first_alarm_time_s = detection.time_s;
       }
     }
+    s.busy_decode_ms += job.frame->decode_ms();
     s.busy_sm_ms += job.sm_ms;
     s.busy_of_ms += job.of_ms;
-    sink(job.frame, detection);
-    s.busy_collector_ms += watch.elapsed_ms();
+    s.busy_label_ms += std::accumulate(job.label_ms.begin(), job.label_ms.end(), 0.0);
+    sink(frame, detection);
+    const double collector_ms = watch.elapsed_ms();
+    s.busy_collector_ms += collector_ms;
+    s.collector_max_ms = std::max(s.collector_max_ms, collector_ms);
   };
 
   try {
     auto run_farm = [&] {
-      par::run_ordered_farm_tasks(
-          farm, [&] { return emitter(); },
-          [&](FrameJob& job) { return make_tasks(job, options); }, collect);
+      par::run_ordered_farm_relay(
+          farm, [&] { return emitter(); }, [&](FrameJob& job) { return make_tasks(job, options); },
+          [&](FrameJob& job) { return relay_tasks(job, detector, options); }, collect);
     };
     // The TBB farm runs in its own arena of `threads`; the sequential one gets an arena here so
     // that OpenCV's own parallel loops respect `threads` too.
@@ -252,9 +335,12 @@ nlohmann::json RunSummary::to_json() const {
             {"mean", latency_mean_ms}}},
           {"busy_ms",
            {{"emitter", busy_emitter_ms},
+            {"decode", busy_decode_ms},
             {"stereo_matching", busy_sm_ms},
             {"optical_flow", busy_of_ms},
+            {"labelling", busy_label_ms},
             {"collector", busy_collector_ms}}},
+          {"collector_max_ms", collector_max_ms},
           {"config",
            {{"mode", mode},
             {"workers", workers},
@@ -274,8 +360,8 @@ std::string RunSummary::text() const {
   s << "alarm frames      " << alarm_frames << "\n";
   s << "first alarm       ";
   if (first_alarm_frame) {
-    s << "frame " << *first_alarm_frame << " (t = " << std::setprecision(2)
-      << *first_alarm_time_s << " s)\n"
+    s << "frame " << *first_alarm_frame << " (t = " << std::setprecision(2) << *first_alarm_time_s
+      << " s)\n"
       << std::setprecision(1);
   } else {
     s << "none\n";

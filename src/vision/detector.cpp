@@ -5,103 +5,134 @@
 
 #include "sg/core/error.hpp"
 #include "sg/vision/labelling.hpp"
-#include "sg/vision/scene_flow.hpp"
 
 namespace sg::vision {
 
+void depth_edges(const core::DetectorParams& params, const cv::Mat& disparity, cv::Mat& edges) {
+  mark_depth_edges(disparity, params.scene_flow.edge_margin_px, params.scene_flow.edge_step_px,
+                   edges);
+}
+
+void LabelJob::run(cv::Range rows) {
+  const core::DetectorParams& p = *params_;
+  if (!flow_mode_) {
+    std::vector<PastDisparity> past;
+    for (size_t j = 0; j < past_.size(); ++j) past.push_back({steps_[j], &past_[j]});
+    label_stereo(disparity_, past, *camera_, p.stereo, p.envelope, danger_, ttc_);
+    return;
+  }
+  std::vector<const cv::Mat*> flows;
+  for (const cv::Mat& f : flows_) flows.push_back(&f);
+  std::vector<GapSource> gaps;
+  for (size_t j = 0; j < past_.size(); ++j)
+    gaps.push_back({steps_[j], &past_[j], &past_edges_[j], spans_s_[j]});
+  label_stereo_flow_rows(disparity_, edges_, flows, gaps, *camera_, p.envelope, p.scene_flow,
+                         danger_, ttc_, velocity_, rows);
+}
+
 Detector::Detector(const core::DetectorParams& params, const core::Camera& camera)
-    : params_(params), camera_(camera), hysteresis_(params.signal) {
+    : params_(params),
+      camera_(camera),
+      hysteresis_(params.signal),
+      tracker_(params.signal, params.envelope.z_contact_m),
+      severity_(params.signal) {
   const std::vector<int>& gaps =
       params_.mode == core::Mode::kStereoFlow ? params_.scene_flow.gaps : params_.stereo.gaps;
   if (!gaps.empty()) max_gap_ = std::max(1, *std::max_element(gaps.begin(), gaps.end()));
 }
 
-void Detector::label_flow(const FrameMaps& maps, cv::Mat& danger, cv::Mat& ttc,
-                          cv::Mat& velocity) {
-  const cv::Mat& disp = maps.disparity;
-  // Gap k needs D_{i-k} and B_i ... B_{i-k+1}: the current flow plus k - 1 stored ones.
-  std::vector<const cv::Mat*> flows;
-  if (!maps.flow.empty()) {
-    flows.push_back(&maps.flow);
-    for (const cv::Mat& f : flows_) flows.push_back(&f);
-  }
-  std::vector<const cv::Mat*> disps, edges;
-  for (const cv::Mat& d : past_) disps.push_back(&d);
-  for (const cv::Mat& e : past_edges_) edges.push_back(&e);
-  const core::SceneFlowParams& sf = params_.scene_flow;
-  mark_depth_edges(disp, sf.edge_margin_px, sf.edge_step_px, edges_);
-  label_stereo_flow_window(disp, disps, flows, camera_, params_.envelope, sf,
-                           camera_.frame_period(), danger, ttc, velocity, &edges_, &edges);
-  if (params_.scene_flow.exclude_ground) {
-    const GroundPlane plane = fit_ground_plane(disp, camera_, params_.scene_flow.ground);
-    cv::Mat ground;
-    mark_ground(disp, camera_, plane, params_.scene_flow.ground.tolerance_m, ground);
-    danger.setTo(0, ground);
-    ttc.setTo(std::numeric_limits<float>::quiet_NaN(), ground);
-  }
-}
-
-core::Detection Detector::process(const core::StereoFrame& frame, const FrameMaps& maps) {
+LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
   const cv::Mat& disp = maps.disparity;
   if (disp.empty() || disp.type() != CV_32FC1)
     throw core::InputError("detector: the disparity map must be a non-empty CV_32F image");
-  if (!past_.empty() && past_.front().size() != disp.size())
+  if (!past_.empty() && past_.front().disparity.size() != disp.size())
     throw core::InputError("detector: the disparity map changed size within a stream");
-
   const bool flow_mode = params_.mode == core::Mode::kStereoFlow;
   if (flow_mode && !maps.flow.empty() &&
       (maps.flow.type() != CV_32FC2 || maps.flow.size() != disp.size()))
     throw core::InputError("detector: the flow must be a CV_32FC2 map of the disparity's size");
-
-  if (!past_index_.empty() && frame.index <= past_index_.front())
+  if (!past_.empty() && frame.index <= past_.front().index)
     throw core::InputError("detector: frames must arrive in increasing index order");
-  // Stereo-Flow chains the flows of consecutive frames; after a dropped frame the chain (and the
-  // past it refers to) starts afresh. Stereo mode measures each gap by frame indices instead.
-  if (flow_mode && !past_index_.empty() && frame.index != past_index_.front() + 1) {
-    past_.clear();
-    past_index_.clear();
-    past_edges_.clear();
-    flows_.clear();
+
+  LabelJob job;
+  job.flow_mode_ = flow_mode;
+  job.params_ = &params_;
+  job.camera_ = &camera_;
+  job.disparity_ = disp;
+  if (flow_mode) {
+    if (maps.edges.empty()) depth_edges(params_, disp, maps.edges);
+    job.edges_ = maps.edges;
+    // The chain B_i, then each past frame's flow to the one before it, while unbroken.
+    if (!maps.flow.empty()) {
+      job.flows_.push_back(maps.flow);
+      for (const Past& e : past_) {
+        if (e.flow.empty()) break;
+        job.flows_.push_back(e.flow);
+      }
+    }
+    const int reach = std::min(static_cast<int>(job.flows_.size()), static_cast<int>(past_.size()));
+    for (int k : params_.scene_flow.gaps) {
+      // Usable once the chain reaches k camera frames back; then the oldest frame at most k
+      // frames back (at least the previous one): without drops exactly frame i - k.
+      if (reach == 0 || frame.index - past_[static_cast<size_t>(reach - 1)].index < k) continue;
+      int m = 0;
+      for (int j = 1; j < reach; ++j)
+        if (frame.index - past_[static_cast<size_t>(j)].index <= k) m = j;
+      const Past& e = past_[static_cast<size_t>(m)];
+      job.past_.push_back(e.disparity);
+      job.past_edges_.push_back(e.edges);
+      job.steps_.push_back(m + 1);
+      job.spans_s_.push_back(frame.time_s - e.time_s);
+    }
+    allocate_stereo_flow_outputs(disp.size(), job.danger_, job.ttc_, job.velocity_);
+  } else {
+    for (int k : params_.stereo.gaps)
+      if (k <= static_cast<int>(past_.size())) {
+        const Past& e = past_[static_cast<size_t>(k - 1)];
+        job.past_.push_back(e.disparity);
+        job.steps_.push_back(frame.index - e.index);
+      }
   }
 
+  // The maps are shared, not copied: nobody writes them after the workers are done.
+  Past entry{frame.index, frame.time_s, disp, flow_mode ? maps.edges : cv::Mat(),
+             flow_mode ? maps.flow : cv::Mat()};
+  past_.push_front(std::move(entry));
+  while (static_cast<int>(past_.size()) > max_gap_) past_.pop_back();
+  return job;
+}
+
+core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) {
   core::Detection det;
   det.frame = frame.index;
   det.time_s = frame.time_s;
-  cv::Mat ttc, velocity;
-  if (flow_mode) {
-    label_flow(maps, det.danger, ttc, velocity);
-  } else {
-    std::vector<PastDisparity> past;
-    for (int k : params_.stereo.gaps)
-      if (k <= static_cast<int>(past_.size()))
-        past.push_back({frame.index - past_index_[static_cast<size_t>(k - 1)],
-                        &past_[static_cast<size_t>(k - 1)]});
-    label_stereo(disp, past, camera_, params_.stereo, params_.envelope, det.danger, ttc);
+  const cv::Mat& disp = job.disparity_;
+  if (job.flow_mode_ && params_.scene_flow.exclude_ground) {
+    const GroundPlane plane = fit_ground_plane(disp, camera_, params_.scene_flow.ground);
+    cv::Mat ground;
+    mark_ground(disp, camera_, plane, params_.scene_flow.ground.tolerance_m, ground);
+    job.danger_.setTo(0, ground);
+    job.ttc_.setTo(std::numeric_limits<float>::quiet_NaN(), ground);
   }
-  det.obstacles = extract_obstacles(det.danger, disp, ttc, camera_, params_.signal, velocity);
+  det.danger = job.danger_;
+  det.obstacles =
+      extract_obstacles(det.danger, disp, job.ttc_, camera_, params_.signal, job.velocity_);
+  tracker_.update(det.time_s, det.obstacles);
   det.regions = hysteresis_.update(count_region_pixels(det.danger, params_.signal.region_columns));
   det.signal = std::any_of(det.regions.begin(), det.regions.end(),
                            [](const core::RegionSignal& r) { return r.fired; });
-  det.severity = severity_of(det.signal, det.obstacles, params_.signal);
+  det.severity =
+      severity_.update(det.signal, severity_of(det.signal, det.obstacles, params_.signal));
   det.steering = steering_hint(det.regions);
-
-  past_.push_front(disp.clone());
-  past_index_.push_front(frame.index);
-  while (static_cast<int>(past_.size()) > max_gap_) {
-    past_.pop_back();
-    past_index_.pop_back();
-  }
-  if (flow_mode) {
-    past_edges_.push_front(edges_.clone());
-    while (static_cast<int>(past_edges_.size()) > max_gap_) past_edges_.pop_back();
-    // The chain B_i, B_{i-1}, ... must be unbroken: a frame without flow starts it afresh.
-    if (maps.flow.empty())
-      flows_.clear();
-    else
-      flows_.push_front(maps.flow.clone());
-    while (static_cast<int>(flows_.size()) > max_gap_ - 1) flows_.pop_back();
-  }
   return det;
+}
+
+core::Detection Detector::process(const core::StereoFrame& frame, const FrameMaps& maps) {
+  // The history shares the maps it keeps; a caller may reuse its buffers for the next frame.
+  FrameMaps own{maps.disparity.clone(), maps.flow.clone(), maps.edges.clone()};
+  LabelJob job = prepare(frame, std::move(own));
+  job.run(cv::Range::all());
+  return finish(frame, job);
 }
 
 }  // namespace sg::vision

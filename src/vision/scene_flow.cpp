@@ -194,7 +194,8 @@ void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const 
                            velocity);
 }
 
-void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const cv::Mat*>& past_disps,
+void label_stereo_flow_window(const cv::Mat& disp_cur,
+                              const std::vector<const cv::Mat*>& past_disps,
                               const std::vector<const cv::Mat*>& past_flows,
                               const core::Camera& cam, const core::Envelope& env,
                               const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
@@ -202,42 +203,69 @@ void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const c
                               const std::vector<const cv::Mat*>* edges_past) {
   if (disp_cur.type() != CV_32FC1) throw core::InputError("scene flow: disparity must be CV_32F");
   const int history = static_cast<int>(std::min(past_disps.size(), past_flows.size()));
-  for (int j = 0; j < history; ++j) {
-    check_same(disp_cur, *past_disps[j], CV_32FC1, "a past disparity");
-    check_same(disp_cur, *past_flows[j], CV_32FC2, "a flow");
+  std::vector<GapSource> gaps;
+  for (int k : p.gaps) {
+    if (k < 1 || k > history) continue;
+    const cv::Mat* edges = nullptr;
+    if (edges_past) {
+      if (k > static_cast<int>(edges_past->size()))
+        throw core::InputError("scene flow: fewer past depth-edge masks than past disparities");
+      edges = (*edges_past)[static_cast<size_t>(k - 1)];
+    }
+    gaps.push_back({k, past_disps[static_cast<size_t>(k - 1)], edges, k * dt});
   }
-  // Gaps we can evaluate, ascending, without duplicates: the chain is walked once per pixel.
-  std::vector<int> gaps;
-  for (int k : p.gaps)
-    if (k >= 1 && k <= history) gaps.push_back(k);
-  std::sort(gaps.begin(), gaps.end());
-  gaps.erase(std::unique(gaps.begin(), gaps.end()), gaps.end());
-
-  danger.create(disp_cur.size(), CV_8UC1);
-  ttc.create(disp_cur.size(), CV_32FC1);
-  velocity.create(disp_cur.size(), CV_32FC3);
-  const cv::Vec3f unknown(kNaN, kNaN, kNaN);
-  const float max_step = static_cast<float>(p.max_disparity_step_px);
-  const PixelTest test(cam, env, p);
   cv::Mat own_edges;
   if (!edges_cur) mark_depth_edges(disp_cur, p.edge_margin_px, p.edge_step_px, own_edges);
   const cv::Mat& edges = edges_cur ? *edges_cur : own_edges;
-  check_same(disp_cur, edges, CV_8UC1, "the depth-edge mask");
-  if (edges_past) {
-    for (int k : gaps) {
-      if (k > static_cast<int>(edges_past->size()))
-        throw core::InputError("scene flow: fewer past depth-edge masks than past disparities");
-      check_same(disp_cur, *(*edges_past)[static_cast<size_t>(k - 1)], CV_8UC1,
-                 "a past depth-edge mask");
-    }
+  allocate_stereo_flow_outputs(disp_cur.size(), danger, ttc, velocity);
+  label_stereo_flow_rows(disp_cur, edges, past_flows, gaps, cam, env, p, danger, ttc, velocity,
+                         cv::Range(0, disp_cur.rows));
+}
+
+void allocate_stereo_flow_outputs(cv::Size size, cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity) {
+  danger.create(size, CV_8UC1);
+  ttc.create(size, CV_32FC1);
+  velocity.create(size, CV_32FC3);
+}
+
+void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
+                            const std::vector<const cv::Mat*>& flows,
+                            const std::vector<GapSource>& gap_sources, const core::Camera& cam,
+                            const core::Envelope& env, const SceneFlowParams& p, cv::Mat& danger,
+                            cv::Mat& ttc, cv::Mat& velocity, cv::Range rows) {
+  if (disp_cur.type() != CV_32FC1) throw core::InputError("scene flow: disparity must be CV_32F");
+  check_same(disp_cur, edges_cur, CV_8UC1, "the depth-edge mask");
+  check_same(disp_cur, danger, CV_8UC1, "the danger output");
+  check_same(disp_cur, ttc, CV_32FC1, "the TTC output");
+  check_same(disp_cur, velocity, CV_32FC3, "the velocity output");
+  // Gaps ascending by chain length, one per length: the chain is walked once per pixel.
+  std::vector<GapSource> gaps;
+  for (const GapSource& g : gap_sources) {
+    if (g.steps < 1 || g.steps > static_cast<int>(flows.size()) || !(g.span_s > 0.0)) continue;
+    check_same(disp_cur, *g.disparity, CV_32FC1, "a past disparity");
+    if (g.edges) check_same(disp_cur, *g.edges, CV_8UC1, "a past depth-edge mask");
+    gaps.push_back(g);
   }
-  // The source q of gap k lies near a depth edge of D_{i-k}.
-  auto past_edge = [&](int k, cv::Point2f at) {
+  std::stable_sort(gaps.begin(), gaps.end(),
+                   [](const GapSource& a, const GapSource& b) { return a.steps < b.steps; });
+  gaps.erase(std::unique(gaps.begin(), gaps.end(),
+                         [](const GapSource& a, const GapSource& b) { return a.steps == b.steps; }),
+             gaps.end());
+  const int longest = gaps.empty() ? 0 : gaps.back().steps;
+  for (int j = 0; j < longest; ++j)
+    check_same(disp_cur, *flows[static_cast<size_t>(j)], CV_32FC2, "a flow");
+  const cv::Range r = rows == cv::Range::all() ? cv::Range(0, disp_cur.rows) : rows;
+
+  const cv::Vec3f unknown(kNaN, kNaN, kNaN);
+  const float max_step = static_cast<float>(p.max_disparity_step_px);
+  const PixelTest test(cam, env, p);
+  // The source q of a gap lies near a depth edge of its past disparity.
+  auto past_edge = [&](const GapSource& g, cv::Point2f at) {
     if (p.edge_margin_px <= 0) return false;
     const int x = std::clamp(cvRound(at.x), 0, disp_cur.cols - 1);
     const int y = std::clamp(cvRound(at.y), 0, disp_cur.rows - 1);
-    if (edges_past) return (*edges_past)[static_cast<size_t>(k - 1)]->at<uint8_t>(y, x) != 0;
-    return near_depth_edge(*past_disps[static_cast<size_t>(k - 1)], x, y, p.edge_margin_px,
+    if (g.edges) return g.edges->at<uint8_t>(y, x) != 0;
+    return near_depth_edge(*g.disparity, x, y, p.edge_margin_px,
                            static_cast<float>(p.edge_step_px));
   };
 
@@ -253,9 +281,9 @@ void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const c
   std::vector<cv::Point2f> q(disp_cur.cols);
   std::vector<int> live;
   live.reserve(disp_cur.cols);
-  for (int y = 0; y < disp_cur.rows; ++y) {
+  for (int y = r.start; y < r.end; ++y) {
     const float* d_row = disp_cur.ptr<float>(y);
-    const uint8_t* edge_row = edges.ptr<uint8_t>(y);
+    const uint8_t* edge_row = edges_cur.ptr<uint8_t>(y);
     uint8_t* danger_row = danger.ptr<uint8_t>(y);
     float* ttc_row = ttc.ptr<float>(y);
     cv::Vec3f* vel_row = velocity.ptr<cv::Vec3f>(y);
@@ -271,9 +299,9 @@ void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const c
       }
     }
     int step = 0;
-    for (int k : gaps) {
-      for (; step < k && !live.empty(); ++step) {
-        const cv::Mat& flow = *past_flows[step];
+    for (const GapSource& g : gaps) {
+      for (; step < g.steps && !live.empty(); ++step) {
+        const cv::Mat& flow = *flows[static_cast<size_t>(step)];
         size_t kept = 0;
         for (const int x : live) {
           cv::Vec2f f;
@@ -285,27 +313,27 @@ void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const c
         live.resize(kept);
       }
       if (live.empty()) break;
-      const cv::Mat& past = *past_disps[k - 1];
+      const cv::Mat& past = *g.disparity;
       for (const int x : live) {
         float d_prev;
         if (!sample_disparity_bilinear(past, q[x].x, q[x].y, d_prev, max_step)) continue;
-        const GapResult r =
-            test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x], d_prev, k * dt);
-        if (!r.velocity_known) continue;
-        const bool dangerous = r.dangerous && !past_edge(k, q[x]);
+        const GapResult res =
+            test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x], d_prev, g.span_s);
+        if (!res.velocity_known) continue;
+        const bool dangerous = res.dangerous && !past_edge(g, q[x]);
         if (p.longest_gap_decides) {
           // Gaps ascend: each known estimate replaces those of the shorter, noisier gaps.
           danger_row[x] = dangerous ? 255 : 0;
-          ttc_row[x] = dangerous ? static_cast<float>(r.ttc) : kNaN;
-          vel_row[x] = cv::Vec3f(r.velocity);
+          ttc_row[x] = dangerous ? static_cast<float>(res.ttc) : kNaN;
+          vel_row[x] = cv::Vec3f(res.velocity);
         } else if (dangerous) {
-          if (danger_row[x] == 0 || r.ttc < ttc_row[x]) {
-            ttc_row[x] = static_cast<float>(r.ttc);
-            vel_row[x] = cv::Vec3f(r.velocity);
+          if (danger_row[x] == 0 || res.ttc < ttc_row[x]) {
+            ttc_row[x] = static_cast<float>(res.ttc);
+            vel_row[x] = cv::Vec3f(res.velocity);
           }
           danger_row[x] = 255;
         } else if (danger_row[x] == 0) {
-          vel_row[x] = cv::Vec3f(r.velocity);  // larger gaps come later: least noisy wins
+          vel_row[x] = cv::Vec3f(res.velocity);  // larger gaps come later: least noisy wins
         }
       }
     }

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <thread>
+
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -338,6 +340,33 @@ TEST(StereoFolderErrors, CorruptPngMidSequence) {
   auto f3 = src.next();
   ASSERT_TRUE(f3);
   EXPECT_EQ(f3->index, 3);
+}
+
+// next_pending reads and stamps only; the pixels come from load(), which may run later on
+// another thread and out of order, and a broken pair throws from its load, not from the read.
+TEST(StereoFolder, PendingFramesDecodeLaterOnAnyThreadAndBreakOnlyInLoad) {
+  ScratchDir tmp;
+  const fs::path dir = tmp.path() / "seq";
+  const Written w = write_folder(dir, 4, false);
+  const fs::path bad = dir / "right" / "000002.png";
+  std::ofstream(bad, std::ios::binary | std::ios::trunc) << "not a png";
+  FolderSource src(dir);
+  std::vector<core::PendingFrame> pending;
+  while (auto p = src.next_pending()) pending.push_back(std::move(*p));
+  ASSERT_EQ(pending.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(pending[i].index, i);
+    EXPECT_DOUBLE_EQ(pending[i].time_s, i / src.camera().fps);
+  }
+  core::StereoFrame f3;
+  std::thread([&] { f3 = pending[3].load(); }).join();  // before frame 0, on another thread
+  EXPECT_EQ(f3.index, 3);
+  expect_equal_mats(f3.left, w.frames[3].left);
+  expect_equal_mats(f3.right, w.frames[3].right);
+  const core::StereoFrame f0 = pending[0].load();
+  expect_equal_mats(f0.left, w.frames[0].left);
+  const std::string msg = input_error_of([&] { pending[2].load(); });
+  EXPECT_NE(msg.find(bad.string()), std::string::npos) << msg;
 }
 
 TEST(StereoFolderErrors, MalformedFramesJsonlLine) {

@@ -279,6 +279,95 @@ TEST_P(FarmTest, MultiTaskItemsCompleteBeforeCollection) {
   EXPECT_LE(tasks_running.max(), GetParam().workers);
 }
 
+// The relay farm: the relay sees items in order after their first tasks, keeps a running history
+// (what the Stereo-Flow detector does with past maps), and its tasks finish before collection.
+struct Relayed {
+  int index = 0;
+  int first = -1;          // written by the first task
+  int history_sum = -1;    // the relay's running sum of `first` up to this item
+  std::vector<int> parts;  // written by the relay's tasks, one slot each
+};
+
+TEST_P(FarmTest, RelayRunsInOrderAndItsTasksFinishBeforeCollection) {
+  constexpr int kItems = 60;
+  Occupancy tasks_running;
+  Occupancy relays_running;
+  int next = 0;
+  int running_sum = 0;
+  std::vector<int> relay_order;
+  std::vector<int> order;
+  run_ordered_farm_relay(
+      config(),
+      [&]() -> std::optional<Relayed> {
+        if (next == kItems) return std::nullopt;
+        Relayed r;
+        r.index = next++;
+        return r;
+      },
+      [&](Relayed& r) -> TaskList {
+        if (r.index % 7 == 6) return {};  // no first task: still relayed
+        return {[&r, &tasks_running] {
+          tasks_running.enter();
+          pause_us(100 + jitter_us(r.index));
+          r.first = 3 * r.index;
+          tasks_running.leave();
+        }};
+      },
+      [&](Relayed& r) -> TaskList {
+        relays_running.enter();
+        relay_order.push_back(r.index);
+        running_sum += std::max(r.first, 0);
+        r.history_sum = running_sum;
+        const int parts = r.index % 5 == 4 ? 0 : 3;
+        r.parts.assign(static_cast<std::size_t>(parts), -1);
+        TaskList tasks;
+        for (int t = 0; t < parts; ++t) {
+          tasks.push_back([&r, t, &tasks_running] {
+            tasks_running.enter();
+            pause_us(50 + jitter_us(r.index + t));
+            r.parts[static_cast<std::size_t>(t)] = r.history_sum + t;
+            tasks_running.leave();
+          });
+        }
+        relays_running.leave();
+        return tasks;
+      },
+      [&](Relayed&& r) {
+        order.push_back(r.index);
+        for (std::size_t t = 0; t < r.parts.size(); ++t) {
+          EXPECT_EQ(r.parts[t], r.history_sum + static_cast<int>(t)) << "item " << r.index;
+        }
+      });
+  std::vector<int> expected(kItems);
+  std::iota(expected.begin(), expected.end(), 0);
+  EXPECT_EQ(relay_order, expected);
+  EXPECT_EQ(order, expected);
+  EXPECT_EQ(relays_running.max(), 1);
+  EXPECT_LE(tasks_running.max(), GetParam().workers);
+  int sum = 0;
+  for (int i = 0; i < kItems; ++i) sum += i % 7 == 6 ? 0 : 3 * i;
+  EXPECT_EQ(running_sum, sum);
+}
+
+TEST_P(FarmTest, RelayTaskExceptionPropagates) {
+  int next = 0;
+  int collected = 0;
+  EXPECT_THROW(run_ordered_farm_relay(
+                   config(),
+                   [&]() -> std::optional<int> {
+                     return next < 500 ? std::optional(next++) : std::nullopt;
+                   },
+                   [](int&) -> TaskList { return {[] { pause_us(20); }}; },
+                   [](int& x) -> TaskList {
+                     return {[&x] {
+                       if (x == 37) throw TestError(x);
+                     }};
+                   },
+                   [&](int&&) { ++collected; }),
+               TestError);
+  EXPECT_LT(collected, 500);
+}
+
 // Tiles nested inside farm workers: a worker waiting in parallel_for must not deadlock the farm.
 TEST_P(FarmTest, NestedTilesInsideWorkers) {
   constexpr int kItems = 20;

@@ -8,6 +8,7 @@
 #include "sg/core/error.hpp"
 #include "sg/io/events.hpp"
 #include "sg/io/memory_source.hpp"
+#include "sg/pipeline/dropping_source.hpp"
 #include "sg/pipeline/runner.hpp"
 #include "sg/sim/renderer.hpp"
 
@@ -112,6 +113,33 @@ TEST(Pipeline, HeadOnClipFiresAndCrossingClipIsAnApproachOnlyInStereoMode) {
   detections(head_on(), options_for(core::Mode::kStereo), &s);
   EXPECT_GT(s.alarm_frames, 0);
   EXPECT_EQ(s.frames, 36);
+}
+
+TEST(DroppingSource, LosesEveryNthFrameKeepingIndicesAndTimes) {
+  std::vector<core::StereoFrame> frames(12);
+  for (int i = 0; i < 12; ++i) {
+    frames[i].index = i;
+    frames[i].time_s = i * 0.1;
+  }
+  io::MemorySource inner(frames, core::Camera{});
+  DroppingSource source(inner, 5);
+  std::vector<int> seen;
+  while (auto f = source.next()) {
+    seen.push_back(f->index);
+    EXPECT_DOUBLE_EQ(f->time_s, f->index * 0.1);
+  }
+  EXPECT_EQ(seen, (std::vector<int>{0, 1, 2, 3, 5, 6, 7, 8, 10, 11}));
+  EXPECT_EQ(source.dropped(), 2);
+}
+
+// Stereo-Flow under 20 % drops: the chain survives them, so the head-on clip still fires.
+TEST(Pipeline, StereoFlowStillFiresWithEveryFifthFrameDropped) {
+  io::MemorySource inner(head_on().frames, head_on().camera);
+  DroppingSource source(inner, 5);
+  RunOptions o = options_for(core::Mode::kStereoFlow);
+  int alarms = 0;
+  run(source, o, [&](const core::StereoFrame&, const core::Detection& d) { alarms += d.signal; });
+  EXPECT_GT(alarms, 0);
 }
 
 TEST(Pipeline, EmptyStream) {

@@ -258,6 +258,32 @@ TEST(DetectorStereoFlow, GapsNeedAnUnbrokenChainOfFlows) {
   EXPECT_TRUE(dangerous[5]);
 }
 
+// A dropped frame (index 3 never arrives) shortens the chain instead of restarting it: frame 4's
+// flow leads to frame 2, so gap 2 compares with frame 2 over one flow and 0.2 s, and the patch
+// stays dangerous; a chain restart would have left frames 4 and 5 without gap 2.
+TEST(DetectorStereoFlow, DroppedFrameShortensTheChain) {
+  core::DetectorParams params = flow_params();
+  params.scene_flow.gaps = {2};
+  params.signal.on_k = 1;
+  params.signal.on_n = 1;
+  Detector det(params, camera());
+  cv::RNG rng(14);
+  std::vector<bool> dangerous;
+  std::vector<double> ttc;
+  for (int i : {0, 1, 2, 4, 5, 6}) {
+    const double z = 5.0 - 0.3 * i;  // 3 m/s at 10 fps
+    const core::Detection d =
+        det.process(frame(i), {scene(z, rng, 0.05), i == 0 ? cv::Mat() : patch_flow(kPatch, 0)});
+    dangerous.push_back(cv::countNonZero(d.danger) > 0);
+    ttc.push_back(d.obstacles.empty() || !d.obstacles[0].ttc_s ? -1.0 : *d.obstacles[0].ttc_s);
+  }
+  EXPECT_FALSE(dangerous[0]);
+  EXPECT_FALSE(dangerous[1]);
+  for (size_t j = 2; j < dangerous.size(); ++j) EXPECT_TRUE(dangerous[j]) << "arrival " << j;
+  // The time span is the real one: frame 4 (z = 3.8 m) against frame 2 (4.4 m) over 0.2 s.
+  EXPECT_NEAR(ttc[3], (3.8 - params.envelope.z_contact_m) / 3.0, 0.25);
+}
+
 TEST(DetectorStereoFlow, BadFlowIsAnInputError) {
   Detector det(flow_params(), camera());
   cv::RNG rng(14);

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/core.hpp>
@@ -377,18 +379,29 @@ cv::Mat random_flow(cv::Size size, double amplitude, cv::RNG& rng) {
   return big(cv::Rect(2, 1, size.width, size.height));
 }
 
-void compare_with_naive(const std::vector<int>& gaps, int history, uint64_t seed,
-                        bool longest = false) {
+/// The small odd camera and wide envelope of the random-map comparisons.
+core::Camera random_map_camera() {
   core::Camera cam = odd_camera();
   cam.width = 63;
   cam.height = 49;
   cam.cx = 31.2;
   cam.cy = 24.6;
-  const cv::Size size(cam.width, cam.height);
+  return cam;
+}
+
+core::Envelope random_map_envelope() {
   core::Envelope env;
   env.half_width_m = 1.5;
   env.y_top_m = -1.5;
   env.y_bottom_m = 1.5;
+  return env;
+}
+
+void compare_with_naive(const std::vector<int>& gaps, int history, uint64_t seed,
+                        bool longest = false) {
+  const core::Camera cam = random_map_camera();
+  const cv::Size size(cam.width, cam.height);
+  const core::Envelope env = random_map_envelope();
   SceneFlowParams p = plain();
   p.longest_gap_decides = longest;
   p.z_max_m = 2.0;  // some of the random points (0.67 .. 2.5 m) lie beyond
@@ -445,6 +458,50 @@ TEST(LabelStereoFlow, MatchesNaiveReferenceOnRandomMaps) {
 TEST(LabelStereoFlowWindow, MatchesNaiveReferenceOnRandomMaps) {
   for (uint64_t seed : {4u, 5u}) compare_with_naive({3, 1, 2}, 3, seed);
   compare_with_naive({1, 2, 5}, 3, 6);  // gap 5 lacks history and is skipped
+}
+
+// The pipeline runs the labelling in row bands on the farm: bands stitched must equal the whole
+// image bit for bit (the whole-image call is itself checked against the naive reference above).
+TEST(LabelStereoFlowRows, BandsStitchedEqualTheWholeImage) {
+  const core::Camera cam = random_map_camera();
+  const cv::Size size(cam.width, cam.height);
+  const core::Envelope env = random_map_envelope();
+  for (bool longest : {false, true}) {
+    SceneFlowParams p = plain();
+    p.longest_gap_decides = longest;
+    p.z_max_m = 2.0;
+    p.gaps = {1, 2, 4};
+    p.min_delta_d_px = 0.2;
+    p.max_disparity_step_px = 1.5;
+    p.edge_margin_px = 1;
+    cv::RNG rng(21 + longest);
+    const cv::Mat cur = random_disparity(size, 8.0, 30.0, rng);
+    std::vector<cv::Mat> disps, flows;
+    std::vector<const cv::Mat*> dp, fp;
+    for (int j = 0; j < 4; ++j) {
+      disps.push_back(random_disparity(size, 6.0, 28.0, rng));
+      flows.push_back(random_flow(size, 6.0, rng));
+    }
+    for (int j = 0; j < 4; ++j) {
+      dp.push_back(&disps[j]);
+      fp.push_back(&flows[j]);
+    }
+    cv::Mat danger, ttc, vel;
+    label_stereo_flow_window(cur, dp, fp, cam, env, p, kDt, danger, ttc, vel);
+    ASSERT_GT(cv::countNonZero(danger), 0);
+    cv::Mat edges;
+    mark_depth_edges(cur, p.edge_margin_px, p.edge_step_px, edges);
+    std::vector<GapSource> gaps;
+    for (int k : {4, 1, 2}) gaps.push_back({k, dp[k - 1], nullptr, k * kDt});
+    cv::Mat bd, bt, bv;
+    allocate_stereo_flow_outputs(size, bd, bt, bv);
+    for (const cv::Range r : {cv::Range(30, 49), cv::Range(0, 7), cv::Range(7, 30)})
+      label_stereo_flow_rows(cur, edges, fp, gaps, cam, env, p, bd, bt, bv, r);
+    EXPECT_EQ(cv::countNonZero(danger != bd), 0) << "longest " << longest;
+    // NaN != NaN: compare the bytes.
+    EXPECT_EQ(std::memcmp(ttc.data, bt.data, ttc.total() * ttc.elemSize()), 0);
+    EXPECT_EQ(std::memcmp(vel.data, bv.data, vel.total() * vel.elemSize()), 0);
+  }
 }
 
 TEST(LabelStereoFlowWindow, LongestGapDecidesMatchesNaiveReference) {

@@ -27,6 +27,10 @@ struct Obstacle {
   double distance_m = 0.0;             ///< median depth of the blob, m
   std::optional<double> ttc_s;         ///< median time to contact, s
   std::optional<cv::Vec3d> velocity;   ///< mean 3D velocity relative to the camera, m/s (Stereo-Flow)
+  int track_id = 0;                    ///< the same obstacle keeps its id across frames; 0 = untracked
+  /// Speed at which the distance shrinks, m/s, from the fit over the track (vision/tracking.hpp);
+  /// when set, distance_m and ttc_s come from that fit too.
+  std::optional<double> closing_speed_mps;
 };
 
 struct Detection {

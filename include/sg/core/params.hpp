@@ -85,6 +85,17 @@ struct SignalParams {
   int off_m = 3;                 ///< ... and off after off_m clear frames
   double ttc_danger_s = 1.5;     ///< severity danger when min TTC <= this, s
   double ttc_warning_s = 3.0;    ///< severity warning when min TTC <= this, s
+  /// Obstacle tracking (vision/tracking.hpp): blobs of consecutive frames whose boxes overlap by
+  /// at least this fraction of the smaller box are one obstacle, (0, 1].
+  double track_min_overlap = 0.3;
+  /// An obstacle's TTC, distance and closing speed come from a straight-line fit of its distance
+  /// over the last ttc_fit_window_s seconds (> 0) once it has ttc_fit_min_frames frames (>= 2)
+  /// in it; before that the blob's median per-pixel TTC stands.
+  double ttc_fit_window_s = 1.0;
+  int ttc_fit_min_frames = 4;
+  /// Severity rises at once but falls only after this many consecutive frames asked for less
+  /// (>= 1), so that it does not flicker between warning and danger.
+  int severity_off_frames = 5;
 };
 
 /// Dense optical flow method (DESIGN 2.2): OpenCV DISOpticalFlow presets or Farneback.

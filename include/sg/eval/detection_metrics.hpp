@@ -29,6 +29,13 @@ struct DetectionReport {
   /// both are empty everywhere).
   double danger_iou = 0.0;
   std::optional<int> first_alarm_frame;
+  /// TTC accuracy over GT alarm frames where a detected obstacle has a TTC: |TTC - GT| / GT of
+  /// the detected obstacle covering most of the GT danger mask, against the colliding obstacle
+  /// nearest to contact. Median and 90th percentile (nearest rank); empty when no such frame.
+  int ttc_frames = 0;
+  std::optional<double> ttc_rel_error_median, ttc_rel_error_p90;
+  /// Frames whose severity differs from the previous frame's (none -> warning -> danger is 2).
+  int severity_changes = 0;
 
   nlohmann::json to_json() const;
   /// A human-readable table, one metric per line.
@@ -51,6 +58,9 @@ class DetectionEvaluator {
   long long inter_ = 0, uni_ = 0;
   std::optional<int> first_alarm_;
   std::map<int, std::optional<double>> lead_;
+  std::vector<double> ttc_errors_;
+  core::Severity last_severity_ = core::Severity::kNone;
+  int severity_changes_ = 0;
 };
 
 }  // namespace sg::eval

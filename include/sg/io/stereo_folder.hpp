@@ -39,6 +39,9 @@ class FolderSource : public core::FrameSource {
  public:
   explicit FolderSource(const std::filesystem::path& dir);
   std::optional<core::StereoFrame> next() override;
+  /// The pair's files are decoded (imread, gray conversion, size check) in PendingFrame::load,
+  /// which may run on another thread; a broken pair throws from load.
+  std::optional<core::PendingFrame> next_pending() override;
   const core::Camera& camera() const override { return camera_; }
   int size() const override { return static_cast<int>(left_.size()); }
 

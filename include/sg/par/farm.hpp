@@ -65,6 +65,9 @@ class BoxedItem final : public FarmItem {
 struct FarmCallbacks {
   std::function<std::unique_ptr<FarmItem>()> emit;  ///< nullptr = end of stream
   std::function<TaskList(FarmItem&)> tasks;
+  /// Optional serial, in-order stage between the item's first tasks and the collector; returns
+  /// the item's second tasks (empty function: no second phase).
+  std::function<TaskList(FarmItem&)> relay;
   std::function<void(FarmItem&)> collect;
 };
 
@@ -76,6 +79,40 @@ template <class T>
 struct IsOptional : std::false_type {};
 template <class T>
 struct IsOptional<std::optional<T>> : std::true_type {};
+
+/// Boxes the typed callbacks for run_farm; `relay` null: no second round of tasks.
+template <class EmitF, class TasksF, class RelayF, class CollectF>
+void run_typed_farm(const FarmConfig& config, EmitF& emit, TasksF& make_tasks, RelayF* relay,
+                    CollectF& collect) {
+  using Emitted = std::invoke_result_t<EmitF&>;
+  static_assert(IsOptional<Emitted>::value, "the emitter must return std::optional<Item>");
+  using Item = typename Emitted::value_type;
+  static_assert(std::is_invocable_r_v<TaskList, TasksF&, Item&>,
+                "make_tasks must be callable as TaskList(Item&)");
+  static_assert(std::is_invocable_r_v<TaskList, RelayF&, Item&>,
+                "relay must be callable as TaskList(Item&)");
+  static_assert(std::is_invocable_v<CollectF&, Item&&>, "collect must be callable with Item&&");
+  using Boxed = BoxedItem<Item>;
+
+  FarmCallbacks callbacks;
+  callbacks.emit = [&emit]() -> std::unique_ptr<FarmItem> {
+    Emitted next = emit();
+    if (!next) return nullptr;
+    return std::make_unique<Boxed>(std::move(*next));
+  };
+  callbacks.tasks = [&make_tasks](FarmItem& item) -> TaskList {
+    return make_tasks(static_cast<Boxed&>(item).value_);
+  };
+  if (relay) {
+    callbacks.relay = [relay](FarmItem& item) -> TaskList {
+      return (*relay)(static_cast<Boxed&>(item).value_);
+    };
+  }
+  callbacks.collect = [&collect](FarmItem& item) {
+    collect(std::move(static_cast<Boxed&>(item).value_));
+  };
+  run_farm(config, callbacks);
+}
 
 }  // namespace detail
 
@@ -97,27 +134,25 @@ struct IsOptional<std::optional<T>> : std::true_type {};
 template <class EmitF, class TasksF, class CollectF>
 void run_ordered_farm_tasks(const FarmConfig& config, EmitF&& emit, TasksF&& make_tasks,
                             CollectF&& collect) {
-  using Emitted = std::invoke_result_t<EmitF&>;
-  static_assert(detail::IsOptional<Emitted>::value, "the emitter must return std::optional<Item>");
-  using Item = typename Emitted::value_type;
-  static_assert(std::is_invocable_r_v<TaskList, TasksF&, Item&>,
-                "make_tasks must be callable as TaskList(Item&)");
-  static_assert(std::is_invocable_v<CollectF&, Item&&>, "collect must be callable with Item&&");
-  using Boxed = detail::BoxedItem<Item>;
+  detail::run_typed_farm(config, emit, make_tasks, static_cast<TasksF*>(nullptr), collect);
+}
 
-  detail::FarmCallbacks callbacks;
-  callbacks.emit = [&emit]() -> std::unique_ptr<detail::FarmItem> {
-    Emitted next = emit();
-    if (!next) return nullptr;
-    return std::make_unique<Boxed>(std::move(*next));
-  };
-  callbacks.tasks = [&make_tasks](detail::FarmItem& item) -> TaskList {
-    return make_tasks(static_cast<Boxed&>(item).value_);
-  };
-  callbacks.collect = [&collect](detail::FarmItem& item) {
-    collect(std::move(static_cast<Boxed&>(item).value_));
-  };
-  detail::run_farm(config, callbacks);
+/// Ordered farm with a second round of tasks per item, FastFlow's pipeline of farm, serial node,
+/// farm, collector on one item:
+///
+///   emit --> tasks (farm) --> relay (serial, in order) --> relay's tasks (farm) --> collect
+///
+/// As run_ordered_farm_tasks, plus `relay(Item&)` -> TaskList, called serially and in emission
+/// order once all first tasks of the item finished; it sees every earlier item's relay but not
+/// necessarily its collect (relay and collect of different items may run at once, so they must
+/// touch different state). Its tasks run on the same W workers, possibly at once with each other
+/// and with other items' tasks; then the item reaches `collect`. The relay is where state that
+/// must follow the stream order (a history of past results) is updated cheaply, so that the
+/// expensive per-item work on that state can leave the serial collector and run on the farm.
+template <class EmitF, class TasksF, class RelayF, class CollectF>
+void run_ordered_farm_relay(const FarmConfig& config, EmitF&& emit, TasksF&& make_tasks,
+                            RelayF&& relay, CollectF&& collect) {
+  detail::run_typed_farm(config, emit, make_tasks, &relay, collect);
 }
 
 /// Ordered farm with one task per item: `emit()` -> std::optional<In>, `work(In&&)` -> Mid run by

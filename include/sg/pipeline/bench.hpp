@@ -46,7 +46,8 @@ struct BenchRow {
   double pace_fps = 0.0;   ///< paced runs: the camera rate, Hz
   int frames = 0, dropped = 0, deadline_misses = 0;
   double fps = 0.0;        ///< throughput, frames / s
-  double speedup = 0.0;    ///< fps / baseline fps of the same mode and resolution
+  double speedup = 0.0;     ///< fps / opencv-mt fps of the same mode and resolution
+  double speedup_1t = 0.0;  ///< fps / baseline (one-thread loop) fps, same mode and resolution
   double latency_p50_ms = 0.0, latency_p99_ms = 0.0, service_ms = 0.0;
   /// Per-frame signals equal to the baseline's (pipeline rows) / to the unpaced run's (paced rows:
   /// only comparable when nothing was dropped).
@@ -54,7 +55,7 @@ struct BenchRow {
 };
 
 /// "kind,mode,width,height,workers,tiles,tokens,pace_fps,frames,dropped,deadline_misses,fps,
-/// speedup,latency_p50_ms,latency_p99_ms,service_ms,same_detections"
+/// speedup,latency_p50_ms,latency_p99_ms,service_ms,same_detections,speedup_1t"
 std::string bench_csv_header();
 /// "yes" / "no", or "n/a" for a paced run that dropped frames.
 std::string same_detections_text(const BenchRow& row);

@@ -1,8 +1,9 @@
 #pragma once
 /// The obstacle pipeline (DESIGN 1): emitter (read, stamp, pace, drop), a farm of W workers
-/// (stereo matching and, in Stereo-Flow mode, optical flow, each split into T row tiles),
-/// collector (restore order, label, signals), and its metrics. This layer wires the vision kernels
-/// onto the par skeletons; it is the only place where both meet.
+/// (decode, stereo matching and, in Stereo-Flow mode, optical flow, each split into T row tiles),
+/// a relay (in order: the detector's history), the labelling as farm tasks in row bands, the
+/// collector (restore order, obstacles, signals), and its metrics. This layer wires the vision
+/// kernels onto the par skeletons; it is the only place where both meet.
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -22,10 +23,10 @@ struct RunOptions {
   /// file: nothing is dropped). When paced, frame n is "captured" at n / pace_fps; a frame whose
   /// successor was captured before a token was free for it is dropped and counted.
   double pace_fps = 0.0;
-  int workers = 1;   ///< W >= 1: farm tasks (SM, OF) running at once
-  int tiles = 1;     ///< T >= 1: row tiles per task
-  int tokens = 0;    ///< frames in flight; 0 = automatic (W + 1)
-  int threads = 0;   ///< task-arena size; 0 = all cores
+  int workers = 1;  ///< W >= 1: farm tasks (SM, OF) running at once
+  int tiles = 1;    ///< T >= 1: row tiles per task
+  int tokens = 0;   ///< frames in flight; 0 = automatic (W + 1)
+  int threads = 0;  ///< task-arena size; 0 = all cores
   /// Split the optical-flow task into tiles too. Off by default: DIS works on an image pyramid,
   /// so tiled flow differs from whole-image flow near the cuts and detections could differ from
   /// the sequential reference; stereo matching tiles are bit-identical and always used.
@@ -43,8 +44,8 @@ int effective_tokens(const RunOptions& options);
 
 /// The run's metrics (DESIGN 1, "Metrics").
 struct RunSummary {
-  int frames = 0;               ///< detections produced
-  int dropped = 0;              ///< frames the paced emitter had to skip
+  int frames = 0;   ///< detections produced
+  int dropped = 0;  ///< frames the paced emitter had to skip
   int alarm_frames = 0;
   std::optional<int> first_alarm_frame;
   std::optional<double> first_alarm_time_s;
@@ -54,9 +55,12 @@ struct RunSummary {
   double service_ms = 0.0;      ///< mean interval between consecutive detections, ms
   double latency_p50_ms = 0.0, latency_p95_ms = 0.0, latency_p99_ms = 0.0, latency_max_ms = 0.0;
   double latency_mean_ms = 0.0;
-  /// Busy time per stage summed over the run, ms: emitter (read, convert), stereo matching,
-  /// optical flow, collector (labelling, signals, sinks).
-  double busy_emitter_ms = 0.0, busy_sm_ms = 0.0, busy_of_ms = 0.0, busy_collector_ms = 0.0;
+  /// Busy time per stage summed over the run, ms: emitter (read and stamp; decoding runs on the
+  /// farm), decode (imread, gray conversion: farm), stereo matching, optical flow, labelling
+  /// (per-pixel danger, farm tasks after the relay), collector (obstacles, signals, sinks).
+  double busy_emitter_ms = 0.0, busy_decode_ms = 0.0, busy_sm_ms = 0.0, busy_of_ms = 0.0,
+         busy_label_ms = 0.0, busy_collector_ms = 0.0;
+  double collector_max_ms = 0.0;  ///< the collector's longest frame, ms
   /// The configuration that ran.
   std::string mode;
   int workers = 1, tiles = 1, tokens = 1, threads = 0;

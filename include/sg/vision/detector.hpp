@@ -1,59 +1,114 @@
 #pragma once
 /// The collector's labelling step around pure functions: owns the past disparity maps and the
 /// hysteresis state; one Detection per frame, in frame order.
+///
+/// A frame passes three steps, which a pipeline may run on different threads:
+///   prepare (serial, in frame order: checks, history)  -> LabelJob
+///   LabelJob::run on row ranges (any threads, tiles)   -> per-pixel danger, TTC, velocity
+///   finish  (serial, in frame order: obstacles, signals) -> Detection
+/// process() runs the three in a row. prepare and finish touch disjoint state, so the prepare of
+/// frame i + 1 may run while frame i's labelling or finish is still running.
 #include <deque>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "sg/core/camera.hpp"
 #include "sg/core/detection.hpp"
 #include "sg/core/frame.hpp"
 #include "sg/core/params.hpp"
+#include "sg/vision/scene_flow.hpp"
 #include "sg/vision/signals.hpp"
+#include "sg/vision/tracking.hpp"
 
 namespace sg::vision {
 
 /// What the workers computed for one frame.
 struct FrameMaps {
   cv::Mat disparity;  ///< CV_32F, px, invalid < 0
-  /// CV_32FC2 backward flow B_i from L_i to L_{i-1} (Stereo-Flow mode), empty for the first
-  /// frame and in Stereo mode.
+  /// CV_32FC2 backward flow B_i from L_i to the left image of the previous frame that reached the
+  /// detector (Stereo-Flow mode), empty for the first frame and in Stereo mode.
   cv::Mat flow;
+  /// Optional CV_8U depth-edge mask of `disparity` (depth_edges()); computed by prepare() when
+  /// empty in Stereo-Flow mode. A worker may compute it right after the disparity.
+  cv::Mat edges;
+};
+
+/// The depth-edge mask the Stereo-Flow labelling uses for `disparity` (mark_depth_edges with the
+/// scene_flow edge settings); CV_8U.
+void depth_edges(const core::DetectorParams& params, const cv::Mat& disparity, cv::Mat& edges);
+
+/// The per-pixel labelling of one frame, made by Detector::prepare: read-only shares of the maps
+/// it reads and its own outputs. run() may be called at once from several threads on disjoint
+/// row ranges; every row must be run once before Detector::finish.
+class LabelJob {
+ public:
+  /// Labels rows `rows` (cv::Range::all(): every row).
+  void run(cv::Range rows);
+  /// True when run() accepts row ranges (Stereo-Flow mode); otherwise call run(all) once.
+  bool tileable() const { return flow_mode_; }
+  /// Image rows.
+  int rows() const { return disparity_.rows; }
+
+ private:
+  friend class Detector;
+  bool flow_mode_ = false;
+  const core::DetectorParams* params_ = nullptr;
+  const core::Camera* camera_ = nullptr;
+  cv::Mat disparity_, edges_;
+  std::vector<cv::Mat> flows_;       ///< Stereo-Flow chain, newest first
+  std::vector<cv::Mat> past_;        ///< past disparities the gaps compare with
+  std::vector<cv::Mat> past_edges_;  ///< their depth edges (Stereo-Flow)
+  std::vector<int> steps_;           ///< Stereo-Flow: flows chained to past_[j]; Stereo: gap frames
+  std::vector<double> spans_s_;      ///< Stereo-Flow: time from past_[j] to now, s
+  cv::Mat danger_, ttc_, velocity_;
 };
 
 class Detector {
  public:
   /// params must be valid (core::validate).
   Detector(const core::DetectorParams& params, const core::Camera& camera);
-  /// Frames must arrive in order. Labels D_i against the past maps of every configured gap k for
-  /// which k frames of history exist (so the first frame is never dangerous): Stereo mode with
-  /// label_stereo (params.stereo), Stereo-Flow mode with label_stereo_flow_window
-  /// (params.scene_flow, dt = camera.frame_period()), whose gap k also needs the flows of the
-  /// last k frames (an empty maps.flow restarts the flow history). Then, in Stereo-Flow mode
-  /// with scene_flow.exclude_ground, dangerous pixels on or below a ground plane fitted to D_i
-  /// are cleared; then obstacles (with the mean 3D velocity in Stereo-Flow mode), region counts,
-  /// hysteresis, severity and steering. Fills frame and time_s from `frame`, danger = the cleaned
-  /// mask; leaves latency_ms to the caller. Throws core::InputError when the disparity is not a
-  /// non-empty CV_32F map, when a non-empty flow is not CV_32FC2 of its size, or when the size
-  /// changes within the stream.
+
+  /// Checks the maps, records them in the history and returns the labelling of this frame against
+  /// the history before it. Frames must arrive in increasing index order; indices count camera
+  /// frames, so a gap in them is a dropped frame. Stereo mode: gap k compares D_i with the map of
+  /// frame i - k when it was kept (label_stereo). Stereo-Flow mode: the history is the chain of
+  /// frames that arrived, each with its flow to the one before it; gap k compares with the oldest
+  /// arrived frame at most k camera frames back (at least the previous arrived one), following
+  /// the flows between them, over the real time between their time_s stamps
+  /// (label_stereo_flow_rows). A dropped frame thus shortens the chains instead of restarting
+  /// them; an empty maps.flow cuts the chain there. Throws core::InputError when the disparity is
+  /// not a non-empty CV_32F map, when a non-empty flow is not CV_32FC2 of its size, when the size
+  /// changes within the stream, or when frames come out of order.
+  LabelJob prepare(const core::StereoFrame& frame, FrameMaps maps);
+
+  /// Turns a labelled frame into its Detection: in Stereo-Flow mode with
+  /// scene_flow.exclude_ground, dangerous pixels on or below a ground plane fitted to D_i are
+  /// cleared; then obstacles (with the mean 3D velocity in Stereo-Flow mode) tracked over frames
+  /// with their TTC from a fit (ObstacleTracker), region counts, hysteresis, severity (held by
+  /// SeverityHold) and steering. Fills frame and time_s from `frame`, danger = the cleaned
+  /// mask; leaves latency_ms to the caller. Jobs must come in the order of prepare.
+  core::Detection finish(const core::StereoFrame& frame, LabelJob& job);
+
+  /// prepare, run over every row, finish.
   core::Detection process(const core::StereoFrame& frame, const FrameMaps& maps);
 
  private:
-  /// Stereo-Flow labelling of D_i with maps.flow and the history; fills danger, ttc, velocity.
-  void label_flow(const FrameMaps& maps, cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity);
+  /// One frame of the history.
+  struct Past {
+    int index = 0;
+    double time_s = 0.0;
+    cv::Mat disparity;
+    cv::Mat edges;  ///< Stereo-Flow
+    cv::Mat flow;   ///< Stereo-Flow: its flow to the next older entry; empty = chain cut
+  };
 
   core::DetectorParams params_;
   core::Camera camera_;
-  int max_gap_ = 1;           ///< longest gap of the active mode
-  std::deque<cv::Mat> past_;  ///< past_[0] = D_{i-1}, past_[1] = D_{i-2}, ...
-  /// Frame index of each past_ map. Frame indices count camera frames, dropped ones included, so
-  /// a paced run that dropped frames still gets the right time span for each gap.
-  std::deque<int> past_index_;
-  /// Stereo-Flow: flows_[0] = B_{i-1}, flows_[1] = B_{i-2}, ... (consecutive, no gap).
-  std::deque<cv::Mat> flows_;
-  /// Stereo-Flow: depth-edge masks (mark_depth_edges) of D_i (edges_) and of past_ (same order).
-  cv::Mat edges_;
-  std::deque<cv::Mat> past_edges_;
-  RegionHysteresis hysteresis_;
+  int max_gap_ = 1;              ///< longest gap of the active mode, camera frames
+  std::deque<Past> past_;        ///< newest first (prepare only)
+  RegionHysteresis hysteresis_;  ///< finish only (as the two below)
+  ObstacleTracker tracker_;
+  SeverityHold severity_;
 };
 
 }  // namespace sg::vision

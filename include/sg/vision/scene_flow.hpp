@@ -56,9 +56,8 @@ void mark_depth_edges(const cv::Mat& disp, int margin_px, double step_px, cv::Ma
 /// heads_into_envelope. p.gaps is not used. Outputs (allocated): danger CV_8U 0/255; ttc CV_32F
 /// s, NaN where safe; velocity CV_32FC3 m/s, NaN where unknown or not a candidate.
 void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const cv::Mat& flow,
-                       const core::Camera& cam, const core::Envelope& env,
-                       const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
-                       cv::Mat& velocity);
+                       const core::Camera& cam, const core::Envelope& env, const SceneFlowParams& p,
+                       double dt, cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity);
 
 /// Stereo-Flow labelling over several frame gaps (p.gaps). past_disps[j] = D_{i-1-j} and
 /// past_flows[j] = B_{i-j} (newest first: past_flows[0] is the current frame's flow). For gap k
@@ -71,12 +70,41 @@ void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const 
 /// from the largest gap that gives one. edges_cur / edges_past (optional): mark_depth_edges of
 /// D_i / of past_disps (same order, same margin and step), when the caller keeps them from frame to
 /// frame; computed here (at q only, for the past) when null.
-void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const cv::Mat*>& past_disps,
+void label_stereo_flow_window(const cv::Mat& disp_cur,
+                              const std::vector<const cv::Mat*>& past_disps,
                               const std::vector<const cv::Mat*>& past_flows,
                               const core::Camera& cam, const core::Envelope& env,
                               const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
                               cv::Mat& velocity, const cv::Mat* edges_cur = nullptr,
                               const std::vector<const cv::Mat*>* edges_past = nullptr);
+
+/// One gap of the Stereo-Flow labelling: the past frame whose disparity the chained flow reaches
+/// after `steps` flows, and the time between it and the current frame.
+struct GapSource {
+  int steps = 1;                       ///< flows chained from the current frame, >= 1
+  const cv::Mat* disparity = nullptr;  ///< D of that past frame, CV_32F, invalid < 0
+  const cv::Mat* edges = nullptr;      ///< its mark_depth_edges, or null (checked at q only)
+  double span_s = 0.0;                 ///< time from that frame to the current one, s (> 0)
+};
+
+/// Allocates the outputs of label_stereo_flow_rows at `size` (danger CV_8U, ttc CV_32F, velocity
+/// CV_32FC3), so that row tiles can then fill them independently.
+void allocate_stereo_flow_outputs(cv::Size size, cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity);
+
+/// The per-pixel test of label_stereo_flow_window on output rows `rows` only (cv::Range::all():
+/// every row), for past frames given explicitly: flows[j] is the backward flow of the j-th newest
+/// frame of the chain (flows[0] = B_i, from the current frame to the frame before it in the
+/// chain); gap g follows g.steps flows and compares with g.disparity over g.span_s seconds. Frames
+/// dropped from a stream make a chain step span several camera frames: the spans carry the real
+/// times. Gaps whose steps exceed flows.size() or whose span is not positive are skipped; of
+/// gaps with equal steps the first given is used. edges_cur = mark_depth_edges of disp_cur.
+/// Outputs must be allocated (allocate_stereo_flow_outputs); only rows `rows` are written, so
+/// tiles stitched give the same maps as one call over all rows.
+void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
+                            const std::vector<const cv::Mat*>& flows,
+                            const std::vector<GapSource>& gaps, const core::Camera& cam,
+                            const core::Envelope& env, const SceneFlowParams& p, cv::Mat& danger,
+                            cv::Mat& ttc, cv::Mat& velocity, cv::Range rows);
 
 /// A plane n . P + c = 0 in camera coordinates (|n| = 1, n pointing up, i.e. n_y < 0).
 struct GroundPlane {

@@ -1,0 +1,60 @@
+#pragma once
+/// Obstacles over time (DESIGN 3.3): the same blob is followed from frame to frame, and its time
+/// to contact comes from a straight-line fit of its distance over the last second instead of the
+/// median of noisy per-pixel TTCs; severity with hysteresis.
+#include <deque>
+#include <vector>
+
+#include "sg/core/detection.hpp"
+#include "sg/core/params.hpp"
+
+namespace sg::vision {
+
+/// Least-squares line z = a + b (t - t_last) through (t, z) samples; false with fewer than two
+/// samples or when every t is equal. distance_now = a (the fit at the last sample's time), m;
+/// rate = b, m/s.
+bool fit_line(const std::vector<double>& t, const std::vector<double>& z, double& distance_now,
+              double& rate);
+
+/// Follows obstacles across frames and replaces each one's distance and TTC by a fit over its
+/// track. Frames must come in time order; dropped frames are fine (the fit uses time stamps).
+class ObstacleTracker {
+ public:
+  /// p must be valid; z_contact_m = the envelope's contact depth, m.
+  ObstacleTracker(const core::SignalParams& p, double z_contact_m);
+
+  /// Matches `obstacles` (this frame's, at time_s) to the tracks of the previous frame: a pair
+  /// matches when their boxes' intersection covers at least track_min_overlap of the smaller box,
+  /// best pairs first; unmatched obstacles start tracks, unmatched tracks end. Sets track_id; for a
+  /// track with ttc_fit_min_frames samples within ttc_fit_window_s, distance_m = the fitted
+  /// distance now, closing_speed_mps = -slope, and ttc_s = (distance - z_contact) / closing speed
+  /// (0 when already inside the contact depth; empty when closing slower than 1 cm/s).
+  void update(double time_s, std::vector<core::Obstacle>& obstacles);
+
+ private:
+  struct Track {
+    int id = 0;
+    cv::Rect bbox;
+    std::deque<double> t, z;  ///< samples of the measured (median) distance
+  };
+  core::SignalParams p_;
+  double z_contact_m_;
+  std::vector<Track> tracks_;
+  int next_id_ = 1;
+};
+
+/// Severity with hysteresis: a higher severity is taken at once, a lower one only after it was
+/// asked for severity_off_frames frames in a row; no signal means none at once (the region
+/// signals have their own hysteresis).
+class SeverityHold {
+ public:
+  explicit SeverityHold(const core::SignalParams& p) : off_frames_(p.severity_off_frames) {}
+  core::Severity update(bool signal, core::Severity wanted);
+
+ private:
+  int off_frames_;
+  core::Severity current_ = core::Severity::kNone;
+  int lower_run_ = 0;
+};
+
+}  // namespace sg::vision

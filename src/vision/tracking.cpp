@@ -1,0 +1,111 @@
+#include "sg/vision/tracking.hpp"
+
+#include <algorithm>
+#include <tuple>
+
+namespace sg::vision {
+namespace {
+
+// Slower closing than this (1 cm/s) is a standing obstacle: no TTC rather than a huge one.
+constexpr double kMinClosingMps = 0.01;
+
+}  // namespace
+
+bool fit_line(const std::vector<double>& t, const std::vector<double>& z, double& distance_now,
+              double& rate) {
+  const size_t n = std::min(t.size(), z.size());
+  if (n < 2) return false;
+  const double t0 = t[n - 1];
+  double st = 0, sz = 0, stt = 0, stz = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double x = t[i] - t0;
+    st += x;
+    sz += z[i];
+    stt += x * x;
+    stz += x * z[i];
+  }
+  const double den = n * stt - st * st;
+  if (!(den > 1e-12)) return false;
+  rate = (n * stz - st * sz) / den;
+  distance_now = (sz - rate * st) / n;
+  return true;
+}
+
+ObstacleTracker::ObstacleTracker(const core::SignalParams& p, double z_contact_m)
+    : p_(p), z_contact_m_(z_contact_m) {}
+
+void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacles) {
+  // Every (overlap, track, obstacle) pair that overlaps enough, best first.
+  std::vector<std::tuple<double, size_t, size_t>> pairs;
+  for (size_t k = 0; k < tracks_.size(); ++k)
+    for (size_t j = 0; j < obstacles.size(); ++j) {
+      const cv::Rect& a = tracks_[k].bbox;
+      const cv::Rect& b = obstacles[j].bbox;
+      const double smaller = std::min(a.area(), b.area());
+      if (smaller <= 0) continue;
+      const double overlap = (a & b).area() / smaller;
+      if (overlap >= p_.track_min_overlap) pairs.emplace_back(overlap, k, j);
+    }
+  std::sort(pairs.begin(), pairs.end(),
+            [](const auto& x, const auto& y) { return std::get<0>(x) > std::get<0>(y); });
+  std::vector<int> track_of(obstacles.size(), -1);
+  std::vector<bool> taken(tracks_.size(), false);
+  for (const auto& [overlap, k, j] : pairs) {
+    if (taken[k] || track_of[j] >= 0) continue;
+    taken[k] = true;
+    track_of[j] = static_cast<int>(k);
+  }
+  std::vector<Track> next;
+  for (size_t j = 0; j < obstacles.size(); ++j) {
+    core::Obstacle& o = obstacles[j];
+    Track track;
+    if (track_of[j] >= 0) {
+      track = std::move(tracks_[static_cast<size_t>(track_of[j])]);
+    } else {
+      track.id = next_id_++;
+    }
+    track.bbox = o.bbox;
+    if (o.distance_m > 0) {
+      track.t.push_back(time_s);
+      track.z.push_back(o.distance_m);
+    }
+    while (!track.t.empty() && track.t.front() < time_s - p_.ttc_fit_window_s - 1e-9) {
+      track.t.pop_front();
+      track.z.pop_front();
+    }
+    o.track_id = track.id;
+    double z_now = 0, rate = 0;
+    if (static_cast<int>(track.t.size()) >= p_.ttc_fit_min_frames &&
+        fit_line({track.t.begin(), track.t.end()}, {track.z.begin(), track.z.end()}, z_now, rate)) {
+      o.distance_m = z_now;
+      o.closing_speed_mps = -rate;
+      if (z_now <= z_contact_m_) {
+        o.ttc_s = 0.0;
+      } else if (-rate > kMinClosingMps) {
+        o.ttc_s = (z_now - z_contact_m_) / -rate;
+      } else {
+        o.ttc_s.reset();
+      }
+    }
+    next.push_back(std::move(track));
+  }
+  tracks_ = std::move(next);
+}
+
+core::Severity SeverityHold::update(bool signal, core::Severity wanted) {
+  if (!signal) {
+    current_ = core::Severity::kNone;
+    lower_run_ = 0;
+    return current_;
+  }
+  if (wanted >= current_) {
+    current_ = wanted;
+    lower_run_ = 0;
+  } else if (++lower_run_ >= off_frames_) {
+    current_ = wanted;
+    lower_run_ = 0;
+  }
+  return current_;
+}
+
+}  // namespace sg::vision
