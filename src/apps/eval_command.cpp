@@ -169,8 +169,8 @@ void eval_main(const EvalArgs& args) {
     eval_flow_main(args);
     return;
   }
-  const pipeline::RunOptions options = make_run_options(args.detector);
   OpenedInput in = open_input(args.input);
+  const pipeline::RunOptions options = make_run_options(args.detector, input_platform(in));
   pipeline::TruthLookup truth_of;
   if (in.scenario) {
     truth_of = [s = in.scenario](int) {

@@ -62,8 +62,8 @@ class WarningPrinter {
 };
 
 void run_main(const RunArgs& args) {
-  const pipeline::RunOptions options = make_run_options(args.detector);
   OpenedInput in = open_input(args.input);
+  const pipeline::RunOptions options = make_run_options(args.detector, input_platform(in));
   const core::Camera& cam = in.source->camera();
   core::throw_if_invalid(pipeline::validate(options, cam), "invalid parameters");
 

@@ -53,6 +53,14 @@ class Section {
 
 }  // namespace
 
+std::optional<std::string> config_platform(const std::filesystem::path& path) {
+  core::DetectorParams ignored;
+  RunSettings settings;
+  apply_config_file(path, ignored, settings);
+  if (settings.platform.empty()) return std::nullopt;
+  return settings.platform;
+}
+
 void apply_config_file(const std::filesystem::path& path, core::DetectorParams& p,
                        RunSettings& settings) {
   const std::string file = path.string();
@@ -76,6 +84,7 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("tiles", settings.tiles)
         .field("tokens", settings.tokens)
         .field("threads", settings.threads)
+        .field("platform", settings.platform)
         .section("stereo")
         .section("label")
         .section("envelope")

@@ -1,6 +1,8 @@
 #pragma once
 /// The YAML configuration file: mirrors the command-line flags (README "Configuration").
 #include <filesystem>
+#include <optional>
+#include <string>
 
 #include "sg/core/params.hpp"
 
@@ -13,7 +15,14 @@ struct RunSettings {
   int tiles = 1;          ///< `tiles:` T, row tiles per task
   int tokens = 0;         ///< `tokens:` frames in flight (0 = automatic)
   int threads = 0;        ///< `threads:` task-arena size (0 = all cores)
+  /// `platform:` preset name (core::apply_platform); read here, applied by the caller before the
+  /// file's other keys (see config_platform).
+  std::string platform;
 };
+
+/// The `platform:` key of a config file, if it has one (for applying the preset first). Throws
+/// core::InputError like apply_config_file for a missing file or bad YAML.
+std::optional<std::string> config_platform(const std::filesystem::path& path);
 
 /// Overwrites the fields of `params` (and `settings`) that the file sets; others keep their value.
 /// Sections: mode, fps, stereo, label, envelope, signal, flow, scene_flow (with scene_flow.ground)
