@@ -4,6 +4,8 @@
 #include <limits>
 
 #include "sg/core/error.hpp"
+#include "sg/vision/edge_margin.hpp"
+#include "sg/vision/ego_motion.hpp"
 #include "sg/vision/labelling.hpp"
 #include "sg/vision/scene_flow.hpp"
 
@@ -16,8 +18,7 @@ Detector::Detector(const core::DetectorParams& params, const core::Camera& camer
   if (!gaps.empty()) max_gap_ = std::max(1, *std::max_element(gaps.begin(), gaps.end()));
 }
 
-void Detector::label_flow(const FrameMaps& maps, cv::Mat& danger, cv::Mat& ttc,
-                          cv::Mat& velocity) {
+void Detector::label_flow(const FrameMaps& maps, cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity) {
   const cv::Mat& disp = maps.disparity;
   // Gap k needs D_{i-k} and B_i ... B_{i-k+1}: the current flow plus k - 1 stored ones.
   std::vector<const cv::Mat*> flows;
@@ -30,8 +31,25 @@ void Detector::label_flow(const FrameMaps& maps, cv::Mat& danger, cv::Mat& ttc,
   for (const cv::Mat& e : past_edges_) edges.push_back(&e);
   const core::SceneFlowParams& sf = params_.scene_flow;
   mark_depth_edges(disp, sf.edge_margin_px, sf.edge_step_px, edges_);
+  if (sf.keep_thin_structures)
+    unmark_thin_structures(disp, sf.edge_margin_px, sf.edge_step_px, edges_);
+  // The camera's own rotation over each gap: per-frame estimates chained, newest first.
+  std::vector<cv::Matx33d> derotations;
+  if (sf.compensate_rotation && !maps.flow.empty()) {
+    frame_derotation_ = derotation(estimate_ego_motion(maps.flow, disp, camera_));
+    cv::Matx33d chain = frame_derotation_;
+    derotations.push_back(chain);
+    for (const cv::Matx33d& m : derotations_) {
+      chain = chain * m;
+      derotations.push_back(chain);
+    }
+  }
   label_stereo_flow_window(disp, disps, flows, camera_, params_.envelope, sf,
-                           camera_.frame_period(), danger, ttc, velocity, &edges_, &edges);
+                           camera_.frame_period(), danger, ttc, velocity, &edges_, &edges,
+                           derotations.empty() ? nullptr : &derotations);
+  if (sf.grow_into_edges)
+    grow_danger_into_edges(disp, edges_, sf.edge_margin_px, sf.edge_step_px,
+                           params_.signal.open_size, danger, ttc, velocity);
   if (params_.scene_flow.exclude_ground) {
     const GroundPlane plane = fit_ground_plane(disp, camera_, params_.scene_flow.ground);
     cv::Mat ground;
@@ -62,6 +80,7 @@ core::Detection Detector::process(const core::StereoFrame& frame, const FrameMap
     past_index_.clear();
     past_edges_.clear();
     flows_.clear();
+    derotations_.clear();
   }
 
   core::Detection det;
@@ -95,11 +114,15 @@ core::Detection Detector::process(const core::StereoFrame& frame, const FrameMap
     past_edges_.push_front(edges_.clone());
     while (static_cast<int>(past_edges_.size()) > max_gap_) past_edges_.pop_back();
     // The chain B_i, B_{i-1}, ... must be unbroken: a frame without flow starts it afresh.
-    if (maps.flow.empty())
+    if (maps.flow.empty()) {
       flows_.clear();
-    else
+      derotations_.clear();
+    } else {
       flows_.push_front(maps.flow.clone());
+      derotations_.push_front(frame_derotation_);
+    }
     while (static_cast<int>(flows_.size()) > max_gap_ - 1) flows_.pop_back();
+    while (static_cast<int>(derotations_.size()) > max_gap_ - 1) derotations_.pop_back();
   }
   return det;
 }

@@ -53,13 +53,15 @@ class PixelTest {
         env_(env),
         p_(p) {}
 
-  GapResult operator()(float x, float y, float d_cur, cv::Point2f q, float d_prev,
-                       double span_s) const {
+  /// derotate (may be null): turns P_{i-k} into frame i's orientation.
+  GapResult operator()(float x, float y, float d_cur, cv::Point2f q, float d_prev, double span_s,
+                       const cv::Matx33d* derotate = nullptr) const {
     GapResult r;
     if (!(d_prev > 0.0f)) return r;  // d_cur > 0 was checked by the caller
     const double z = fb_ / d_cur, zp = fb_ / d_prev;
     const cv::Vec3d P((x - cx_) * z * inv_f_, (y - cy_) * z * inv_f_, z);
-    const cv::Vec3d Pp((q.x - cx_) * zp * inv_f_, (q.y - cy_) * zp * inv_f_, zp);
+    cv::Vec3d Pp((q.x - cx_) * zp * inv_f_, (q.y - cy_) * zp * inv_f_, zp);
+    if (derotate) Pp = *derotate * Pp;
     r.velocity = (P - Pp) * (1.0 / span_s);
     r.velocity_known = true;
     if (static_cast<double>(d_cur) - d_prev < p_.min_delta_d_px ||
@@ -199,7 +201,8 @@ void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const c
                               const core::Camera& cam, const core::Envelope& env,
                               const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
                               cv::Mat& velocity, const cv::Mat* edges_cur,
-                              const std::vector<const cv::Mat*>* edges_past) {
+                              const std::vector<const cv::Mat*>* edges_past,
+                              const std::vector<cv::Matx33d>* derotations) {
   if (disp_cur.type() != CV_32FC1) throw core::InputError("scene flow: disparity must be CV_32F");
   const int history = static_cast<int>(std::min(past_disps.size(), past_flows.size()));
   for (int j = 0; j < history; ++j) {
@@ -289,8 +292,12 @@ void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const c
       for (const int x : live) {
         float d_prev;
         if (!sample_disparity_bilinear(past, q[x].x, q[x].y, d_prev, max_step)) continue;
-        const GapResult r =
-            test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x], d_prev, k * dt);
+        const cv::Matx33d* derotate =
+            derotations && k <= static_cast<int>(derotations->size())
+                ? &(*derotations)[static_cast<size_t>(k - 1)]
+                : nullptr;
+        const GapResult r = test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x],
+                                 d_prev, k * dt, derotate);
         if (!r.velocity_known) continue;
         const bool dangerous = r.dangerous && !past_edge(k, q[x]);
         if (p.longest_gap_decides) {

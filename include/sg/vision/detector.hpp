@@ -28,7 +28,10 @@ class Detector {
   /// which k frames of history exist (so the first frame is never dangerous): Stereo mode with
   /// label_stereo (params.stereo), Stereo-Flow mode with label_stereo_flow_window
   /// (params.scene_flow, dt = camera.frame_period()), whose gap k also needs the flows of the
-  /// last k frames (an empty maps.flow restarts the flow history). Then, in Stereo-Flow mode
+  /// last k frames (an empty maps.flow restarts the flow history); with scene_flow.
+  /// compensate_rotation the camera's rotation is estimated from each flow (estimate_ego_motion)
+  /// and removed over every gap; keep_thin_structures and grow_into_edges adjust the depth-edge
+  /// margin (vision/edge_margin.hpp). Then, in Stereo-Flow mode
   /// with scene_flow.exclude_ground, dangerous pixels on or below a ground plane fitted to D_i
   /// are cleared; then obstacles (with the mean 3D velocity in Stereo-Flow mode), region counts,
   /// hysteresis, severity and steering. Fills frame and time_s from `frame`, danger = the cleaned
@@ -53,6 +56,10 @@ class Detector {
   /// Stereo-Flow: depth-edge masks (mark_depth_edges) of D_i (edges_) and of past_ (same order).
   cv::Mat edges_;
   std::deque<cv::Mat> past_edges_;
+  /// Stereo-Flow with compensate_rotation: derotation of each stored flow's frame
+  /// (derotations_[0] belongs to flows_[0]), and of the current frame.
+  std::deque<cv::Matx33d> derotations_;
+  cv::Matx33d frame_derotation_ = cv::Matx33d::eye();
   RegionHysteresis hysteresis_;
 };
 

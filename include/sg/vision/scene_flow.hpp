@@ -70,13 +70,16 @@ void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const 
 /// the flagging gaps and its velocity that of the gap giving it; a safe pixel's velocity comes
 /// from the largest gap that gives one. edges_cur / edges_past (optional): mark_depth_edges of
 /// D_i / of past_disps (same order, same margin and step), when the caller keeps them from frame to
-/// frame; computed here (at q only, for the past) when null.
+/// frame; computed here (at q only, for the past) when null. derotations (optional):
+/// (*derotations)[k-1] turns camera i-k coordinates into camera i's orientation (the camera's own
+/// rotation over the gap, vision/ego_motion.hpp), applied to P_{i-k} before V is formed.
 void label_stereo_flow_window(const cv::Mat& disp_cur, const std::vector<const cv::Mat*>& past_disps,
                               const std::vector<const cv::Mat*>& past_flows,
                               const core::Camera& cam, const core::Envelope& env,
                               const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
                               cv::Mat& velocity, const cv::Mat* edges_cur = nullptr,
-                              const std::vector<const cv::Mat*>* edges_past = nullptr);
+                              const std::vector<const cv::Mat*>* edges_past = nullptr,
+                              const std::vector<cv::Matx33d>* derotations = nullptr);
 
 /// A plane n . P + c = 0 in camera coordinates (|n| = 1, n pointing up, i.e. n_y < 0).
 struct GroundPlane {
