@@ -222,7 +222,14 @@ void render_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, c
       }
       if (flow) {
         cv::Vec2f q(0.0f, 0.0f);
-        if (hit.surface != Surface::kSky) {
+        if (hit.surface == Surface::kSky) {
+          // At infinity only the rotation moves the sky: the same direction a frame earlier.
+          const cv::Vec3d rel = sc.rot_prev.t() * dir;
+          if (rel[2] > kMinHitDepth) {
+            q[0] = static_cast<float>(sc.cx + sc.f * rel[0] / rel[2] - x);
+            q[1] = static_cast<float>(sc.cy + sc.f * rel[1] / rel[2] - y);
+          }
+        } else {
           // The same surface point one frame earlier, seen from the camera one frame earlier.
           cv::Vec3d p = eye + dir * hit.depth;
           if (is_box) p += sc.boxes[hit.box].shift_prev;
