@@ -22,7 +22,7 @@ cv::Mat scene_with(const cv::Rect& r, double z) {
 
 TEST(ThinStructures, PoleIsMarkedButNotWideObjectsBordersOrTheFarSide) {
   const int margin = 8;
-  cv::Mat d = scene_with({320, 100, 5, 200}, 5.0);  // a 5 px pole
+  cv::Mat d = scene_with({320, 100, 5, 200}, 5.0);           // a 5 px pole
   d(cv::Rect(100, 100, 60, 60)).setTo(kCam.disparity(6.0));  // a 60 px box
   d(cv::Rect(0, 300, 6, 40)).setTo(kCam.disparity(6.0));     // a strip at the image border
   d(cv::Rect(400, 50, 200, 12)).setTo(kCam.disparity(4.0));  // a 12 px high bar
@@ -30,11 +30,11 @@ TEST(ThinStructures, PoleIsMarkedButNotWideObjectsBordersOrTheFarSide) {
   mark_thin_structures(d, margin, 1.0, 2 * margin + 1, thin);
   EXPECT_EQ(thin.at<uchar>(200, 322), 255);  // pole
   EXPECT_EQ(thin.at<uchar>(200, 320), 255);
-  EXPECT_EQ(thin.at<uchar>(56, 500), 255);   // bar (thin along its columns)
-  EXPECT_EQ(thin.at<uchar>(200, 318), 0);    // background beside the pole: something nearer
+  EXPECT_EQ(thin.at<uchar>(56, 500), 255);  // bar (thin along its columns)
+  EXPECT_EQ(thin.at<uchar>(200, 318), 0);   // background beside the pole: something nearer
   EXPECT_EQ(thin.at<uchar>(200, 330), 0);
-  EXPECT_EQ(thin.at<uchar>(105, 105), 0);    // box corner: its runs are 60 px long
-  EXPECT_EQ(thin.at<uchar>(320, 2), 0);      // the border strip may go on outside the image
+  EXPECT_EQ(thin.at<uchar>(105, 105), 0);  // box corner: its runs are 60 px long
+  EXPECT_EQ(thin.at<uchar>(320, 2), 0);    // the border strip may go on outside the image
   // The depth-edge mask loses the pole; unmark_thin_structures gives it back, and only it.
   cv::Mat edges;
   mark_depth_edges(d, margin, 1.0, edges);
@@ -42,9 +42,8 @@ TEST(ThinStructures, PoleIsMarkedButNotWideObjectsBordersOrTheFarSide) {
   cv::Mat before = edges.clone();
   unmark_thin_structures(d, margin, 1.0, edges);
   EXPECT_EQ(cv::countNonZero(edges(cv::Rect(320, 100, 5, 200))), 0);
-  EXPECT_EQ(cv::countNonZero(edges(cv::Rect(100, 100, 60, 60)) !=
-                             before(cv::Rect(100, 100, 60, 60))),
-            0);
+  EXPECT_EQ(
+      cv::countNonZero(edges(cv::Rect(100, 100, 60, 60)) != before(cv::Rect(100, 100, 60, 60))), 0);
 }
 
 /// Stereo-Flow detector on exact maps of a robot approaching a pole at 2 m/s: frames 0..n-1
