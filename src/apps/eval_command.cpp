@@ -193,17 +193,17 @@ void eval_main(const EvalArgs& args) {
     eval_stereo_main(s);
     return;
   }
+  InputOptions input = args.input;
+  input.spec.left = args.left;  // --left/--right are shared with --flow
+  input.spec.right = args.right;
+  OpenedInput in = open_input(input, args.detector.config);
   io::RunSettings settings;
-  pipeline::RunOptions options = make_run_options(args.detector, &settings);
+  pipeline::RunOptions options = make_run_options(args.detector, input_platform(in), &settings);
   const ResolvedOutputs outputs = resolve_outputs(args.outputs, settings);
   if (outputs.scale != 1.0) {
     throw core::InputError("scale: eval does not rescale the ground truth; use scale only with run");
   }
   options.keep_maps = !outputs.dump.empty();
-  InputOptions input = args.input;
-  input.spec.left = args.left;  // --left/--right are shared with --flow
-  input.spec.right = args.right;
-  OpenedInput in = open_input(input, args.detector.config);
   pipeline::TruthLookup truth_of;
   if (in.scenario) {
     truth_of = [s = in.scenario](int) {

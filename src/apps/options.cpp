@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "sg/core/error.hpp"
+#include "sg/core/platform.hpp"
 #include "sg/io/config.hpp"
 #include "sg/io/stereo_folder.hpp"
 
@@ -110,6 +111,10 @@ cv::Size parse_size(const std::string& text, const std::string& name, const std:
   return {w, h};
 }
 
+std::string input_platform(const OpenedInput& input) {
+  return input.scenario ? input.scenario->scenario().platform : std::string();
+}
+
 void add_detector_options(CLI::App& app, DetectorOptions& o) {
   app.add_option("--config", o.config, "YAML config file (flags given too override it)");
   app.add_option("--mode", o.mode, "stereo (default) or stereo-flow");
@@ -128,6 +133,9 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                  "Stereo-Flow optical flow: dis-ultrafast (default), dis-fast, dis-medium or "
                  "farneback");
   app.add_option("--min-area", o.min_area, "smallest obstacle blob, px (default 150)");
+  app.add_option("--platform", o.platform,
+                 "detector preset of a platform: robot (default), walker or car (envelope, "
+                 "disparity range, depth limits); default: the scenario's");
   app.add_option("--fps", o.fps, "pace the input like a camera at this rate, Hz (0 = no pacing)");
   app.add_option("--workers", o.workers,
                  "W: farm workers computing SM/OF tasks at once (default 1)");
@@ -138,9 +146,17 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                "split optical flow into the T tiles too (faster, not bit-identical)");
 }
 
-pipeline::RunOptions make_run_options(const DetectorOptions& o, io::RunSettings* settings_out) {
+pipeline::RunOptions make_run_options(const DetectorOptions& o,
+                                      const std::string& default_platform,
+                                      io::RunSettings* settings_out) {
   pipeline::RunOptions run;
   io::RunSettings settings;
+  std::string platform = default_platform;
+  if (!o.config.empty()) {
+    if (auto from_file = io::config_platform(o.config)) platform = *from_file;
+  }
+  if (o.platform) platform = *o.platform;
+  core::apply_platform(platform, run.params);
   if (!o.config.empty()) io::apply_config_file(o.config, run.params, settings);
   if (settings_out) *settings_out = settings;
   run.pace_fps = settings.pace_fps;

@@ -53,15 +53,21 @@ struct DetectorOptions {
   std::optional<int> num_disparities, block_size, min_area;
   std::optional<std::vector<int>> gaps;
   std::optional<std::string> flow_method;
+  std::optional<std::string> platform;
   std::optional<double> fps;
   std::optional<int> workers, tiles, tokens, threads;
   bool tile_flow = false;
 };
 
 void add_detector_options(CLI::App& app, DetectorOptions& options);
-/// Defaults, then the config file, then the flags. Not validated here (pipeline::run does).
-/// `settings`, when given, receives the config file's run settings (outputs, scale).
+/// Defaults, then the platform preset (--platform, else the config's `platform` key, else
+/// `default_platform`, e.g. the scenario's), then the config file, then the flags. Not validated
+/// here (pipeline::run does). `settings`, when given, receives the config file's run settings
+/// (outputs, scale).
 pipeline::RunOptions make_run_options(const DetectorOptions& options,
+                                      const std::string& default_platform = "",
                                       io::RunSettings* settings = nullptr);
+/// The platform a scenario input is made for ("" for a folder or a scenario without one).
+std::string input_platform(const OpenedInput& input);
 
 }  // namespace sg::apps

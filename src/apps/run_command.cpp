@@ -67,11 +67,11 @@ class WarningPrinter {
 };
 
 void run_main(const RunArgs& args) {
+  OpenedInput in = open_input(args.input, args.detector.config);
   io::RunSettings settings;
-  pipeline::RunOptions options = make_run_options(args.detector, &settings);
+  pipeline::RunOptions options = make_run_options(args.detector, input_platform(in), &settings);
   const ResolvedOutputs outputs = resolve_outputs(args.outputs, settings);
   options.keep_maps = !outputs.dump.empty();
-  OpenedInput in = open_input(args.input, args.detector.config);
   in.source = io::scale_source(std::move(in.source), outputs.scale);
   const core::Camera& cam = in.source->camera();
   core::throw_if_invalid(pipeline::validate(options, cam), "invalid parameters");

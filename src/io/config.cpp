@@ -63,6 +63,14 @@ class Section {
 
 }  // namespace
 
+std::optional<std::string> config_platform(const std::filesystem::path& path) {
+  core::DetectorParams ignored;
+  RunSettings settings;
+  apply_config_file(path, ignored, settings);
+  if (settings.platform.empty()) return std::nullopt;
+  return settings.platform;
+}
+
 void apply_config_file(const std::filesystem::path& path, core::DetectorParams& p,
                        RunSettings& settings) {
   const std::string file = path.string();
@@ -89,6 +97,7 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("scale", settings.scale)
         .field("csv", settings.csv)
         .field("dump", settings.dump)
+        .field("platform", settings.platform)
         .section("stereo")
         .section("label")
         .section("envelope")
@@ -165,6 +174,9 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("max_disparity_step_px", p.scene_flow.max_disparity_step_px)
         .field("edge_margin_px", p.scene_flow.edge_margin_px)
         .field("edge_step_px", p.scene_flow.edge_step_px)
+        .field("keep_thin_structures", p.scene_flow.keep_thin_structures)
+        .field("grow_into_edges", p.scene_flow.grow_into_edges)
+        .field("compensate_rotation", p.scene_flow.compensate_rotation)
         .field("longest_gap_decides", p.scene_flow.longest_gap_decides)
         .field("use_envelope_band", p.scene_flow.use_envelope_band)
         .field("exclude_ground", p.scene_flow.exclude_ground)

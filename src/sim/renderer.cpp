@@ -22,7 +22,8 @@ enum class Surface : std::uint8_t { kSky, kGround, kWall, kBox };
 
 /// A box at the frame time, in world coordinates.
 struct BoxNow {
-  cv::Vec3d lo, hi, centre, velocity;
+  cv::Vec3d lo, hi, centre;
+  cv::Vec3d shift_prev;  // centre one frame earlier minus centre now, m
   int id = 0;
   std::uint32_t seed = 0;
   double albedo = 0.0;
@@ -33,6 +34,8 @@ struct Scene {
   double f = 0, cx = 0, cy = 0, baseline = 0, dt = 0;
   cv::Vec3d eye;       // left camera at the frame time
   cv::Vec3d eye_prev;  // left camera one frame earlier
+  cv::Matx33d rot = cv::Matx33d::eye();       // camera-to-world rotation at the frame time
+  cv::Matx33d rot_prev = cv::Matx33d::eye();  // ... one frame earlier
   double ground_y = 0, wall_z = 0, wall_top_y = 0;
   std::uint32_t ground_seed = 0, wall_seed = 0;
   double ground_albedo = 0, wall_albedo = 0;
@@ -40,10 +43,10 @@ struct Scene {
 };
 
 struct Hit {
-  double depth = kInf;  // ray parameter of (dx, dy, 1) = depth in the camera, m
+  double depth = kInf;  // ray parameter of R (dx, dy, 1) = depth in the camera, m
   Surface surface = Surface::kSky;
   int box = -1;   // index into Scene::boxes
-  int axis = 2;   // normal axis of the face hit
+  int axis = 2;   // normal axis (world) of the face hit
   int side = 0;   // 0 = the face at the low coordinate, 1 = the high one
 };
 
@@ -60,6 +63,8 @@ Scene make_scene(const Scenario& s, int index) {
   sc.dt = 1.0 / s.camera.fps;
   sc.eye = s.ego_velocity_mps * t;
   sc.eye_prev = s.ego_velocity_mps * (t - sc.dt);
+  sc.rot = camera_rotation(s.camera_motion, t);
+  sc.rot_prev = camera_rotation(s.camera_motion, t - sc.dt);
   sc.ground_y = s.height_m;
   sc.wall_z = s.background_z_m;
   sc.wall_top_y = s.height_m - s.background_height_m;
@@ -69,10 +74,10 @@ Scene make_scene(const Scenario& s, int index) {
   sc.wall_albedo = albedo_of(s.background_seed);
   for (const Box& b : s.obstacles) {
     BoxNow n;
-    n.centre = b.position_m + b.velocity_mps * t;
+    n.centre = box_position(b, t);
     n.lo = n.centre - b.size_m * 0.5;
     n.hi = n.centre + b.size_m * 0.5;
-    n.velocity = b.velocity_mps;
+    n.shift_prev = box_position(b, t - sc.dt) - n.centre;
     n.id = b.id;
     n.seed = b.texture_seed;
     n.albedo = albedo_of(b.texture_seed);
@@ -86,26 +91,27 @@ double safe_component(double v) {
   return std::abs(v) < kTiny ? (v < 0 ? -kTiny : kTiny) : v;
 }
 
-/// Nearest surface along o + s * (dx, dy, 1), s > 0.
-Hit cast(const Scene& sc, const cv::Vec3d& o, double dx, double dy) {
+/// Nearest surface along o + s * dir, s > 0 (dir = R (dx, dy, 1), world frame).
+Hit cast(const Scene& sc, const cv::Vec3d& o, const cv::Vec3d& dir) {
   Hit hit;
-  if (dy > 0) {
-    const double s = (sc.ground_y - o[1]) / dy;
+  if (dir[1] > 0) {
+    const double s = (sc.ground_y - o[1]) / dir[1];
     if (s > kMinHitDepth) {
       hit.depth = s;
       hit.surface = Surface::kGround;
       hit.axis = 1;
     }
   }
-  {
-    const double s = sc.wall_z - o[2];
-    if (s > kMinHitDepth && s < hit.depth && o[1] + s * dy >= sc.wall_top_y) {
+  if (dir[2] > 0) {
+    const double s = (sc.wall_z - o[2]) / dir[2];
+    if (s > kMinHitDepth && s < hit.depth && o[1] + s * dir[1] >= sc.wall_top_y) {
       hit.depth = s;
       hit.surface = Surface::kWall;
       hit.axis = 2;
     }
   }
-  const double inv[3] = {1.0 / safe_component(dx), 1.0 / safe_component(dy), 1.0};
+  const double inv[3] = {1.0 / safe_component(dir[0]), 1.0 / safe_component(dir[1]),
+                         1.0 / safe_component(dir[2])};
   for (std::size_t i = 0; i < sc.boxes.size(); ++i) {
     const BoxNow& b = sc.boxes[i];
     double t_near = -kInf, t_far = kInf;
@@ -136,30 +142,32 @@ Hit cast(const Scene& sc, const cv::Vec3d& o, double dx, double dy) {
   return hit;
 }
 
-/// Size in texture units of the pixel footprint on a face with normal `axis`, using ray
-/// differentials of the direction (dx, dy, 1) at depth `depth`.
-double footprint(const Scene& sc, int axis, double depth, double dx, double dy, int u_axis,
+/// Size in texture units of the pixel footprint on a face with (world) normal `axis`, using ray
+/// differentials of the direction dir = R (dx, dy, 1) at depth `depth`.
+double footprint(const Scene& sc, int axis, double depth, const cv::Vec3d& dir, int u_axis,
                  int v_axis, double u_scale, double v_scale) {
-  cv::Vec3d ddx(1, 0, 0), ddy(0, 1, 0);
-  const cv::Vec3d dir(dx, dy, 1.0);
-  if (axis == 0) ddx -= dir * (1.0 / safe_component(dx));
-  if (axis == 1) ddy -= dir * (1.0 / safe_component(dy));
+  // d dir / d dx and d dir / d dy, moved along the ray onto the face's plane.
+  cv::Vec3d ddx(sc.rot(0, 0), sc.rot(1, 0), sc.rot(2, 0));
+  cv::Vec3d ddy(sc.rot(0, 1), sc.rot(1, 1), sc.rot(2, 1));
+  const double inv = 1.0 / safe_component(dir[axis]);
+  ddx -= dir * (ddx[axis] * inv);
+  ddy -= dir * (ddy[axis] * inv);
   const double fu = std::max(std::abs(ddx[u_axis]), std::abs(ddy[u_axis])) / u_scale;
   const double fv = std::max(std::abs(ddx[v_axis]), std::abs(ddy[v_axis])) / v_scale;
   return depth / sc.f * std::max(fu, fv);
 }
 
 /// Gray level (before noise and gain) of the surface hit by the ray from o.
-double shade(const Scene& sc, const Hit& hit, const cv::Vec3d& o, double dx, double dy) {
+double shade(const Scene& sc, const Hit& hit, const cv::Vec3d& o, const cv::Vec3d& dir) {
   if (hit.surface == Surface::kSky) return kSkyGray;
-  const cv::Vec3d p = o + cv::Vec3d(dx, dy, 1.0) * hit.depth;
+  const cv::Vec3d p = o + dir * hit.depth;
   if (hit.surface == Surface::kGround) {
-    const double fp = footprint(sc, 1, hit.depth, dx, dy, 0, 2, 1.0, kGroundStretchZ);
+    const double fp = footprint(sc, 1, hit.depth, dir, 0, 2, 1.0, kGroundStretchZ);
     return sc.ground_albedo +
            kContrast * texture_value(p[0], p[2] / kGroundStretchZ, sc.ground_seed, fp);
   }
   if (hit.surface == Surface::kWall) {
-    const double fp = footprint(sc, 2, hit.depth, dx, dy, 0, 1, 1.0, 1.0);
+    const double fp = footprint(sc, 2, hit.depth, dir, 0, 1, 1.0, 1.0);
     return sc.wall_albedo + kContrast * texture_value(p[0], p[1], sc.wall_seed, fp);
   }
   const BoxNow& b = sc.boxes[static_cast<std::size_t>(hit.box)];
@@ -169,7 +177,7 @@ double shade(const Scene& sc, const Hit& hit, const cv::Vec3d& o, double dx, dou
   static constexpr int kV[3] = {1, 2, 1};
   static constexpr double kFaceShade[3] = {0.8, 1.15, 1.0};
   const int u = kU[hit.axis], v = kV[hit.axis];
-  const double fp = footprint(sc, hit.axis, hit.depth, dx, dy, u, v, 1.0, 1.0);
+  const double fp = footprint(sc, hit.axis, hit.depth, dir, u, v, 1.0, 1.0);
   const auto face = static_cast<std::uint32_t>(hit.axis * 2 + hit.side);
   return b.albedo * kFaceShade[hit.axis] +
          kContrast * texture_value(local[u], local[v], hash_combine(b.seed, face), fp);
@@ -198,9 +206,10 @@ void render_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, c
     auto* ids = out.ids ? out.ids->ptr<std::uint16_t>(y) : nullptr;
     for (int x = 0; x < width; ++x) {
       const double dx = (x - sc.cx) / sc.f;
-      const Hit hit = cast(sc, eye, dx, dy);
+      const cv::Vec3d dir = sc.rot * cv::Vec3d(dx, dy, 1.0);
+      const Hit hit = cast(sc, eye, dir);
       if (gray) {
-        double value = shade(sc, hit, eye, dx, dy) * out.gain;
+        double value = shade(sc, hit, eye, dir) * out.gain;
         if (noise) value += noise[x];
         gray[x] = cv::saturate_cast<std::uint8_t>(value);
       }
@@ -213,11 +222,18 @@ void render_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, c
       }
       if (flow) {
         cv::Vec2f q(0.0f, 0.0f);
-        if (hit.surface != Surface::kSky) {
+        if (hit.surface == Surface::kSky) {
+          // At infinity only the rotation moves the sky: the same direction a frame earlier.
+          const cv::Vec3d rel = sc.rot_prev.t() * dir;
+          if (rel[2] > kMinHitDepth) {
+            q[0] = static_cast<float>(sc.cx + sc.f * rel[0] / rel[2] - x);
+            q[1] = static_cast<float>(sc.cy + sc.f * rel[1] / rel[2] - y);
+          }
+        } else {
           // The same surface point one frame earlier, seen from the camera one frame earlier.
-          cv::Vec3d p = eye + cv::Vec3d(dx, dy, 1.0) * hit.depth;
-          if (is_box) p -= sc.boxes[hit.box].velocity * sc.dt;
-          const cv::Vec3d rel = p - sc.eye_prev;
+          cv::Vec3d p = eye + dir * hit.depth;
+          if (is_box) p += sc.boxes[hit.box].shift_prev;
+          const cv::Vec3d rel = sc.rot_prev.t() * (p - sc.eye_prev);
           if (rel[2] > kMinHitDepth) {
             q[0] = static_cast<float>(sc.cx + sc.f * rel[0] / rel[2] - x);
             q[1] = static_cast<float>(sc.cy + sc.f * rel[1] / rel[2] - y);
@@ -277,12 +293,53 @@ void check_index(const Scenario& s, int index) {
 
 }  // namespace
 
-core::ObstacleTruth box_collision(const Scenario& s, const Box& box, double t_s) {
+namespace {
+
+/// box_collision for a turning camera: steps the future (box at its current velocity, camera on
+/// its own path and rotation) and checks the box's bounds in the camera frame of each instant.
+core::ObstacleTruth turning_collision(const Scenario& s, const Box& box, double t_s) {
+  constexpr double kStep = 1e-3;  // s
   core::ObstacleTruth o;
   o.id = box.id;
   const core::Envelope& e = s.envelope;
-  const cv::Vec3d rel = box.position_m + (box.velocity_mps - s.ego_velocity_mps) * t_s;
-  const cv::Vec3d v = box.velocity_mps - s.ego_velocity_mps;
+  const cv::Vec3d centre = box_position(box, t_s), velocity = box_velocity(box, t_s);
+  const cv::Vec3d half = box.size_m * 0.5;
+  const int steps = static_cast<int>(std::ceil(e.horizon_s / kStep));
+  for (int i = 0; i <= steps; ++i) {
+    const double tau = std::min(i * kStep, e.horizon_s);
+    const cv::Matx33d to_camera = camera_rotation(s.camera_motion, t_s + tau).t();
+    const cv::Vec3d eye = s.ego_velocity_mps * (t_s + tau);
+    const cv::Vec3d c = centre + velocity * tau;
+    cv::Vec3d lo(kInf, kInf, kInf), hi(-kInf, -kInf, -kInf);
+    for (int k = 0; k < 8; ++k) {
+      const cv::Vec3d corner(c[0] + ((k & 1) ? half[0] : -half[0]),
+                             c[1] + ((k & 2) ? half[1] : -half[1]),
+                             c[2] + ((k & 4) ? half[2] : -half[2]));
+      const cv::Vec3d q = to_camera * (corner - eye);
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], q[a]);
+        hi[a] = std::max(hi[a], q[a]);
+      }
+    }
+    if (lo[2] <= e.z_contact_m && hi[2] >= 0.0 && hi[0] >= -e.half_width_m &&
+        lo[0] <= e.half_width_m && hi[1] >= e.y_top_m && lo[1] <= e.y_bottom_m) {
+      o.colliding = true;
+      o.ttc_s = tau;
+      return o;
+    }
+  }
+  return o;
+}
+
+}  // namespace
+
+core::ObstacleTruth box_collision(const Scenario& s, const Box& box, double t_s) {
+  if (s.camera_motion.rotates()) return turning_collision(s, box, t_s);
+  core::ObstacleTruth o;
+  o.id = box.id;
+  const core::Envelope& e = s.envelope;
+  const cv::Vec3d rel = box_position(box, t_s) - s.ego_velocity_mps * t_s;
+  const cv::Vec3d v = box_velocity(box, t_s) - s.ego_velocity_mps;
   const cv::Vec3d half = box.size_m * 0.5;
   const auto overlaps_at = [&](double dt) {
     const cv::Vec3d c = rel + v * dt;
@@ -351,7 +408,7 @@ RenderedFrame Renderer::render(int index) const {
   right.gray = &r.frame.right;
   right.noise = noise[1].empty() ? nullptr : &noise[1];
   right.gain = s.right_gain;
-  render_parallel(sc, sc.eye + cv::Vec3d(s.camera.baseline_m, 0, 0), right, w, h);
+  render_parallel(sc, sc.eye + sc.rot * cv::Vec3d(s.camera.baseline_m, 0, 0), right, w, h);
 
   r.truth = frame_truth(s, index, r.maps.ids, &r.maps.danger);
   return r;

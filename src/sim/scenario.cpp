@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -11,6 +12,7 @@
 #include <sstream>
 
 #include "sg/core/error.hpp"
+#include "sg/core/platform.hpp"
 
 namespace sg::sim {
 namespace {
@@ -155,14 +157,39 @@ void read_envelope(const YamlReader& r, const YAML::Node& n, core::Envelope& e) 
   if (n["horizon_s"]) e.horizon_s = r.number(n["horizon_s"], "envelope.horizon_s");
 }
 
+void read_camera_motion(const YamlReader& r, const YAML::Node& n, CameraMotion& m) {
+  r.expect_map(n, "camera_motion",
+               {"yaw_rate_dps", "pitch_amplitude_deg", "roll_amplitude_deg", "oscillation_hz"});
+  if (n["yaw_rate_dps"]) m.yaw_rate_dps = r.number(n["yaw_rate_dps"], "camera_motion.yaw_rate_dps");
+  if (n["pitch_amplitude_deg"])
+    m.pitch_amplitude_deg = r.number(n["pitch_amplitude_deg"], "camera_motion.pitch_amplitude_deg");
+  if (n["roll_amplitude_deg"])
+    m.roll_amplitude_deg = r.number(n["roll_amplitude_deg"], "camera_motion.roll_amplitude_deg");
+  if (n["oscillation_hz"])
+    m.oscillation_hz = r.number(n["oscillation_hz"], "camera_motion.oscillation_hz");
+}
+
 Box read_box(const YamlReader& r, const YAML::Node& n, const std::string& field) {
-  r.expect_map(n, field, {"id", "size_m", "position_m", "velocity_mps", "texture_seed"});
+  r.expect_map(n, field,
+               {"id", "size_m", "position_m", "velocity_mps", "accelerations", "texture_seed"});
   Box b;
   if (n["id"]) b.id = r.integer(n["id"], field + ".id");
   if (n["size_m"]) b.size_m = r.vec3(n["size_m"], field + ".size_m");
   if (n["position_m"]) b.position_m = r.vec3(n["position_m"], field + ".position_m");
   if (n["velocity_mps"]) b.velocity_mps = r.vec3(n["velocity_mps"], field + ".velocity_mps");
   if (n["texture_seed"]) b.texture_seed = r.seed(n["texture_seed"], field + ".texture_seed");
+  if (const YAML::Node phases = n["accelerations"]) {
+    if (!phases.IsSequence()) r.fail(phases, field + ".accelerations", "expected a list");
+    for (std::size_t i = 0; i < phases.size(); ++i) {
+      const std::string f = field + ".accelerations[" + std::to_string(i) + "]";
+      r.expect_map(phases[i], f, {"from_s", "acceleration_mps2"});
+      AccelerationPhase ph;
+      if (phases[i]["from_s"]) ph.from_s = r.number(phases[i]["from_s"], f + ".from_s");
+      if (phases[i]["acceleration_mps2"])
+        ph.acceleration_mps2 = r.vec3(phases[i]["acceleration_mps2"], f + ".acceleration_mps2");
+      b.accelerations.push_back(ph);
+    }
+  }
   return b;
 }
 
@@ -170,6 +197,7 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
   if (root.IsNull()) r.fail(root, "(document)", "the file is empty");
   r.expect_map(root, "",
                {"name", "description", "frames", "camera", "height_m", "ego_velocity_mps",
+                "camera_motion", "platform",
                 "background_z_m", "background_height_m", "ground_seed", "background_seed",
                 "noise_sigma", "right_gain", "noise_seed", "envelope", "min_area_px",
                 "obstacles"});
@@ -182,6 +210,8 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
   if (root["height_m"]) s.height_m = r.number(root["height_m"], "height_m");
   if (root["ego_velocity_mps"])
     s.ego_velocity_mps = r.vec3(root["ego_velocity_mps"], "ego_velocity_mps");
+  if (root["camera_motion"]) read_camera_motion(r, root["camera_motion"], s.camera_motion);
+  if (root["platform"]) s.platform = r.text(root["platform"], "platform");
   if (root["background_z_m"]) s.background_z_m = r.number(root["background_z_m"], "background_z_m");
   if (root["background_height_m"])
     s.background_height_m = r.number(root["background_height_m"], "background_height_m");
@@ -205,6 +235,58 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
 
 }  // namespace
 
+cv::Vec3d box_position(const Box& box, double t_s) {
+  cv::Vec3d p = box.position_m, v = box.velocity_mps;
+  double t = 0.0;  // p, v hold the state at time t
+  for (std::size_t i = 0; i < box.accelerations.size(); ++i) {
+    const AccelerationPhase& ph = box.accelerations[i];
+    if (ph.from_s >= t_s) break;
+    if (ph.from_s > t) {  // coast from t to the phase start (no acceleration before phase 0)
+      p += v * (ph.from_s - t);
+      t = ph.from_s;
+    }
+    const double end = i + 1 < box.accelerations.size()
+                           ? std::min(t_s, box.accelerations[i + 1].from_s)
+                           : t_s;
+    const double span = end - t;
+    if (span > 0) {
+      p += v * span + ph.acceleration_mps2 * (0.5 * span * span);
+      v += ph.acceleration_mps2 * span;
+      t = end;
+    }
+  }
+  return p + v * (t_s - t);
+}
+
+cv::Vec3d box_velocity(const Box& box, double t_s) {
+  cv::Vec3d v = box.velocity_mps;
+  for (std::size_t i = 0; i < box.accelerations.size(); ++i) {
+    const AccelerationPhase& ph = box.accelerations[i];
+    if (ph.from_s >= t_s) break;
+    const double end = i + 1 < box.accelerations.size()
+                           ? std::min(t_s, box.accelerations[i + 1].from_s)
+                           : t_s;
+    if (end > ph.from_s) v += ph.acceleration_mps2 * (end - ph.from_s);
+  }
+  return v;
+}
+
+cv::Matx33d camera_rotation(const CameraMotion& m, double t_s) {
+  constexpr double kDeg = CV_PI / 180.0;
+  const double phase = 2.0 * CV_PI * m.oscillation_hz * t_s;
+  const double yaw = m.yaw_rate_dps * kDeg * t_s;
+  const double pitch = m.pitch_amplitude_deg * kDeg * std::sin(phase);
+  const double roll = m.roll_amplitude_deg * kDeg * std::cos(phase);
+  const double cy = std::cos(yaw), sy = std::sin(yaw);
+  const double cp = std::cos(pitch), sp = std::sin(pitch);
+  const double cr = std::cos(roll), sr = std::sin(roll);
+  // R_y turns +Z towards +X; R_x with positive pitch turns +Z towards -Y (up, y is down).
+  const cv::Matx33d ry(cy, 0, sy, 0, 1, 0, -sy, 0, cy);
+  const cv::Matx33d rx(1, 0, 0, 0, cp, -sp, 0, sp, cp);
+  const cv::Matx33d rz(cr, -sr, 0, sr, cr, 0, 0, 0, 1);
+  return ry * rx * rz;
+}
+
 std::vector<std::string> validate(const Scenario& s) {
   std::vector<std::string> out = core::validate(s.camera);
   Checker c(out);
@@ -221,6 +303,24 @@ std::vector<std::string> validate(const Scenario& s) {
   c.require(std::isfinite(s.right_gain) && s.right_gain > 0, "right_gain", s.right_gain,
             "must be > 0");
   c.require(s.min_area_px >= 0, "min_area_px", s.min_area_px, "must be >= 0");
+  const CameraMotion& m = s.camera_motion;
+  c.require(std::isfinite(m.yaw_rate_dps), "camera_motion.yaw_rate_dps", m.yaw_rate_dps,
+            "must be finite");
+  c.require(std::isfinite(m.pitch_amplitude_deg) && std::abs(m.pitch_amplitude_deg) <= 45,
+            "camera_motion.pitch_amplitude_deg", m.pitch_amplitude_deg, "must be in -45..45");
+  c.require(std::isfinite(m.roll_amplitude_deg) && std::abs(m.roll_amplitude_deg) <= 45,
+            "camera_motion.roll_amplitude_deg", m.roll_amplitude_deg, "must be in -45..45");
+  c.require(std::isfinite(m.oscillation_hz) && m.oscillation_hz > 0,
+            "camera_motion.oscillation_hz", m.oscillation_hz, "must be > 0");
+  if (!s.platform.empty()) {
+    bool known = false;
+    std::string list;
+    for (const auto& n : core::platform_names()) {
+      known = known || n == s.platform;
+      list += (list.empty() ? "" : ", ") + n;
+    }
+    c.require(known, "platform", s.platform, ("must be one of: " + list).c_str());
+  }
   for (const auto& e : core::validate(s.envelope)) out.push_back(e);
   std::set<int> ids;
   for (std::size_t i = 0; i < s.obstacles.size(); ++i) {
@@ -234,6 +334,15 @@ std::vector<std::string> validate(const Scenario& s) {
               "must be finite");
     c.require(finite(b.velocity_mps), field + ".velocity_mps", to_text(b.velocity_mps),
               "must be finite");
+    for (std::size_t k = 0; k < b.accelerations.size(); ++k) {
+      const AccelerationPhase& ph = b.accelerations[k];
+      const std::string f = field + ".accelerations[" + std::to_string(k) + "]";
+      c.require(std::isfinite(ph.from_s) && ph.from_s >= 0 &&
+                    (k == 0 || ph.from_s > b.accelerations[k - 1].from_s),
+                f + ".from_s", ph.from_s, "must be >= 0 and increase from phase to phase");
+      c.require(finite(ph.acceleration_mps2), f + ".acceleration_mps2",
+                to_text(ph.acceleration_mps2), "must be finite");
+    }
   }
   return out;
 }
@@ -290,6 +399,15 @@ std::string to_yaml(const Scenario& s) {
   e << YAML::Key << "height_m" << YAML::Value << to_text(s.height_m);
   e << YAML::Key << "ego_velocity_mps" << YAML::Value;
   vec(s.ego_velocity_mps);
+  e << YAML::Key << "camera_motion" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "yaw_rate_dps" << YAML::Value << to_text(s.camera_motion.yaw_rate_dps);
+  e << YAML::Key << "pitch_amplitude_deg" << YAML::Value
+    << to_text(s.camera_motion.pitch_amplitude_deg);
+  e << YAML::Key << "roll_amplitude_deg" << YAML::Value
+    << to_text(s.camera_motion.roll_amplitude_deg);
+  e << YAML::Key << "oscillation_hz" << YAML::Value << to_text(s.camera_motion.oscillation_hz);
+  e << YAML::EndMap;
+  e << YAML::Key << "platform" << YAML::Value << YAML::DoubleQuoted << s.platform;
   e << YAML::Key << "background_z_m" << YAML::Value << to_text(s.background_z_m);
   e << YAML::Key << "background_height_m" << YAML::Value << to_text(s.background_height_m);
   e << YAML::Key << "ground_seed" << YAML::Value << s.ground_seed;
@@ -315,6 +433,17 @@ std::string to_yaml(const Scenario& s) {
     vec(b.position_m);
     e << YAML::Key << "velocity_mps" << YAML::Value;
     vec(b.velocity_mps);
+    if (!b.accelerations.empty()) {
+      e << YAML::Key << "accelerations" << YAML::Value << YAML::BeginSeq;
+      for (const AccelerationPhase& ph : b.accelerations) {
+        e << YAML::Flow << YAML::BeginMap;
+        e << YAML::Key << "from_s" << YAML::Value << to_text(ph.from_s);
+        e << YAML::Key << "acceleration_mps2" << YAML::Value;
+        vec(ph.acceleration_mps2);
+        e << YAML::EndMap;
+      }
+      e << YAML::EndSeq;
+    }
     e << YAML::Key << "texture_seed" << YAML::Value << b.texture_seed;
     e << YAML::EndMap;
   }

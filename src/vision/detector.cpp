@@ -4,13 +4,17 @@
 #include <limits>
 
 #include "sg/core/error.hpp"
+#include "sg/vision/edge_margin.hpp"
+#include "sg/vision/ego_motion.hpp"
 #include "sg/vision/labelling.hpp"
 
 namespace sg::vision {
 
 void depth_edges(const core::DetectorParams& params, const cv::Mat& disparity, cv::Mat& edges) {
-  mark_depth_edges(disparity, params.scene_flow.edge_margin_px, params.scene_flow.edge_step_px,
-                   edges);
+  const core::SceneFlowParams& sf = params.scene_flow;
+  mark_depth_edges(disparity, sf.edge_margin_px, sf.edge_step_px, edges);
+  if (sf.keep_thin_structures)
+    unmark_thin_structures(disparity, sf.edge_margin_px, sf.edge_step_px, edges);
 }
 
 void LabelJob::run(cv::Range rows) {
@@ -25,7 +29,8 @@ void LabelJob::run(cv::Range rows) {
   for (const cv::Mat& f : flows_) flows.push_back(&f);
   std::vector<GapSource> gaps;
   for (size_t j = 0; j < past_.size(); ++j)
-    gaps.push_back({steps_[j], &past_[j], &past_edges_[j], spans_s_[j]});
+    gaps.push_back({steps_[j], &past_[j], &past_edges_[j], spans_s_[j],
+                    derotations_.empty() ? nullptr : &derotations_[j]});
   label_stereo_flow_rows(disparity_, edges_, flows, gaps, *camera_, p.envelope, p.scene_flow,
                          danger_, ttc_, velocity_, rows);
 }
@@ -55,6 +60,7 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
     throw core::InputError("detector: frames must arrive in increasing index order");
 
   LabelJob job;
+  cv::Matx33d flow_derotation = cv::Matx33d::eye();  // of maps.flow (compensate_rotation)
   job.flow_mode_ = flow_mode;
   job.params_ = &params_;
   job.camera_ = &camera_;
@@ -71,6 +77,8 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
       }
     }
     const int reach = std::min(static_cast<int>(job.flows_.size()), static_cast<int>(past_.size()));
+    const bool derotate = params_.scene_flow.compensate_rotation && !maps.flow.empty();
+    if (derotate) flow_derotation = derotation(estimate_ego_motion(maps.flow, disp, camera_));
     for (int k : params_.scene_flow.gaps) {
       // Usable once the chain reaches k camera frames back; then the oldest frame at most k
       // frames back (at least the previous one): without drops exactly frame i - k.
@@ -83,6 +91,12 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
       job.past_edges_.push_back(e.edges);
       job.steps_.push_back(m + 1);
       job.spans_s_.push_back(frame.time_s - e.time_s);
+      if (derotate) {
+        // The rotations of the flows chained to past_[m], newest first.
+        cv::Matx33d chain = flow_derotation;
+        for (int j = 0; j < m; ++j) chain = chain * past_[static_cast<size_t>(j)].derotation;
+        job.derotations_.push_back(chain);
+      }
     }
     allocate_stereo_flow_outputs(disp.size(), job.danger_, job.ttc_, job.velocity_);
   } else {
@@ -96,7 +110,7 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
 
   // The maps are shared, not copied: nobody writes them after the workers are done.
   Past entry{frame.index, frame.time_s, disp, flow_mode ? maps.edges : cv::Mat(),
-             flow_mode ? maps.flow : cv::Mat()};
+             flow_mode ? maps.flow : cv::Mat(), flow_derotation};
   past_.push_front(std::move(entry));
   while (static_cast<int>(past_.size()) > max_gap_) past_.pop_back();
   return job;
@@ -107,6 +121,10 @@ core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) 
   det.frame = frame.index;
   det.time_s = frame.time_s;
   const cv::Mat& disp = job.disparity_;
+  const core::SceneFlowParams& sf = params_.scene_flow;
+  if (job.flow_mode_ && sf.grow_into_edges)
+    grow_danger_into_edges(disp, job.edges_, sf.edge_margin_px, sf.edge_step_px,
+                           params_.signal.open_size, job.danger_, job.ttc_, job.velocity_);
   if (job.flow_mode_ && params_.scene_flow.exclude_ground) {
     const GroundPlane plane = fit_ground_plane(disp, camera_, params_.scene_flow.ground);
     cv::Mat ground;

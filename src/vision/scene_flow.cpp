@@ -53,13 +53,15 @@ class PixelTest {
         env_(env),
         p_(p) {}
 
-  GapResult operator()(float x, float y, float d_cur, cv::Point2f q, float d_prev,
-                       double span_s) const {
+  /// derotate (may be null): turns P_{i-k} into frame i's orientation.
+  GapResult operator()(float x, float y, float d_cur, cv::Point2f q, float d_prev, double span_s,
+                       const cv::Matx33d* derotate = nullptr) const {
     GapResult r;
     if (!(d_prev > 0.0f)) return r;  // d_cur > 0 was checked by the caller
     const double z = fb_ / d_cur, zp = fb_ / d_prev;
     const cv::Vec3d P((x - cx_) * z * inv_f_, (y - cy_) * z * inv_f_, z);
-    const cv::Vec3d Pp((q.x - cx_) * zp * inv_f_, (q.y - cy_) * zp * inv_f_, zp);
+    cv::Vec3d Pp((q.x - cx_) * zp * inv_f_, (q.y - cy_) * zp * inv_f_, zp);
+    if (derotate) Pp = *derotate * Pp;
     r.velocity = (P - Pp) * (1.0 / span_s);
     r.velocity_known = true;
     if (static_cast<double>(d_cur) - d_prev < p_.min_delta_d_px ||
@@ -317,8 +319,8 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
       for (const int x : live) {
         float d_prev;
         if (!sample_disparity_bilinear(past, q[x].x, q[x].y, d_prev, max_step)) continue;
-        const GapResult res =
-            test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x], d_prev, g.span_s);
+        const GapResult res = test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x],
+                                   d_prev, g.span_s, g.derotate);
         if (!res.velocity_known) continue;
         const bool dangerous = res.dangerous && !past_edge(g, q[x]);
         if (p.longest_gap_decides) {

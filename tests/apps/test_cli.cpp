@@ -224,6 +224,28 @@ TEST_F(Cli, FolderAndScenarioGiveTheSameEvaluation) {
   EXPECT_GT(a["gt_alarm_frames"].get<int>(), 0);  // the small scenario does approach
 }
 
+// Platform presets: the car preset's 128 disparities do not fit a 120 px wide image, so whether
+// it was applied shows in the validation error.
+TEST_F(Cli, ScenarioPlatformIsAppliedUnlessAFlagOrConfigSaysOtherwise) {
+  std::ofstream(dir_ / "narrow.yaml")
+      << "name: narrow\nframes: 3\nplatform: car\n"
+      << "camera: {width: 120, height: 90, focal_px: 100, cx: 60, cy: 45}\n"
+      << "obstacles:\n  - {id: 1, size_m: [1, 1, 1], position_m: [0, 0.7, 6]}\n";
+  expect_user_error(run("eval --scenario narrow.yaml"), "num_disparities=128");
+  EXPECT_EQ(run("eval --scenario narrow.yaml --platform robot").status, 0);
+  std::ofstream(dir_ / "robot.yaml") << "platform: robot\n";
+  EXPECT_EQ(run("eval --scenario narrow.yaml --config robot.yaml").status, 0);
+  std::ofstream(dir_ / "car.yaml") << "platform: car\n";
+  expect_user_error(run("eval --scenario narrow.yaml --config car.yaml --platform walker "
+                        "--num-disparities 256"),
+                    "num_disparities=256");  // flags still override the preset
+}
+
+TEST_F(Cli, UnknownPlatform) {
+  expect_user_error(run("run --scenario '" + small_scenario().string() + "' --platform boat"),
+                    "unknown platform 'boat'");
+}
+
 TEST_F(Cli, EvalWithoutGroundTruth) {
   const fs::path folder = small_folder(3);
   fs::remove_all(folder / "gt");

@@ -87,6 +87,19 @@ TEST(Config, BadFlowMethodAndUnknownSceneFlowKeysAreNamed) {
   EXPECT_NE(message.find("scene_flow.gaps"), std::string::npos) << message;
 }
 
+TEST(Config, PlatformKeyIsReadButLeftToTheCaller) {
+  ScratchDir dir;
+  const auto path = write_file(dir, "platform: car\nenvelope: {half_width_m: 0.8}\n");
+  EXPECT_EQ(config_platform(path), std::optional<std::string>("car"));
+  core::DetectorParams p;
+  RunSettings s;
+  apply_config_file(path, p, s);
+  EXPECT_EQ(s.platform, "car");
+  EXPECT_EQ(p.bm.num_disparities, core::DetectorParams{}.bm.num_disparities);  // not applied
+  EXPECT_DOUBLE_EQ(p.envelope.half_width_m, 0.8);
+  EXPECT_FALSE(config_platform(write_file(dir, "mode: stereo\n")).has_value());
+}
+
 TEST(Config, EmptyFileChangesNothing) {
   ScratchDir dir;
   core::DetectorParams p;

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "sg/core/error.hpp"
+#include "sg/core/platform.hpp"
 #include "sg/sim/scenario.hpp"
 
 namespace sg::sim {
@@ -40,8 +41,9 @@ std::string load_error(const std::string& path) {
 TEST(Scenario, BuiltinsIncludeTheRequiredOnesAndValidate) {
   const auto names = builtin_scenario_names();
   const std::set<std::string> have(names.begin(), names.end());
-  for (const char* required : {"head-on", "crossing", "receding", "static", "ego-wall",
-                               "ego-pass", "two-obstacles"})
+  for (const char* required :
+       {"head-on", "crossing", "receding", "static", "ego-wall", "ego-pass", "two-obstacles",
+        "thin-pole", "overhang", "turning", "car-stopped", "car-cut-in"})
     EXPECT_TRUE(have.count(required)) << required;
   for (const auto& name : names) {
     const Scenario s = builtin_scenario(name);
@@ -49,7 +51,15 @@ TEST(Scenario, BuiltinsIncludeTheRequiredOnesAndValidate) {
     EXPECT_FALSE(s.description.empty()) << name;
     EXPECT_FALSE(s.obstacles.empty()) << name;
     EXPECT_TRUE(validate(s).empty()) << name << ": " << validate(s).front();
-    // Every built-in uses the default camera and envelope.
+    EXPECT_DOUBLE_EQ(s.envelope.horizon_s, 3.0);
+    if (!s.platform.empty()) {
+      // Platform scenarios use their platform's envelope for the ground truth.
+      const core::Envelope e = core::platform_envelope(s.platform);
+      EXPECT_EQ(s.envelope.half_width_m, e.half_width_m) << name;
+      EXPECT_EQ(s.envelope.z_contact_m, e.z_contact_m) << name;
+      continue;
+    }
+    // Every other built-in uses the default camera and envelope.
     EXPECT_EQ(s.camera.width, 640);
     EXPECT_EQ(s.camera.height, 480);
     EXPECT_DOUBLE_EQ(s.camera.focal_px, 500.0);
@@ -119,11 +129,24 @@ TEST(Scenario, YamlRoundTripKeepsEveryField) {
   s.envelope = {0.6, -0.9, 0.8, 0.4, 2.5};
   s.min_area_px = 77;
   s.obstacles[1].texture_seed = 1234;
+  s.camera_motion = {12.5, 2.0, -1.5, 1.75};
+  s.platform = "walker";
+  s.obstacles[0].accelerations = {{0.5, {1.0, 0.0, -2.0}}, {1.25, {0, 0, 0}}};
   const std::string path = write_file("roundtrip.yaml", "");
   save_scenario_file(s, path);
   const Scenario r = load_scenario_file(path);
   EXPECT_EQ(r.name, s.name);
   EXPECT_EQ(r.description, s.description);
+  EXPECT_EQ(r.camera_motion.yaw_rate_dps, 12.5);
+  EXPECT_EQ(r.camera_motion.pitch_amplitude_deg, 2.0);
+  EXPECT_EQ(r.camera_motion.roll_amplitude_deg, -1.5);
+  EXPECT_EQ(r.camera_motion.oscillation_hz, 1.75);
+  EXPECT_EQ(r.platform, "walker");
+  ASSERT_EQ(r.obstacles[0].accelerations.size(), 2u);
+  EXPECT_EQ(r.obstacles[0].accelerations[0].from_s, 0.5);
+  EXPECT_EQ(r.obstacles[0].accelerations[0].acceleration_mps2, cv::Vec3d(1.0, 0.0, -2.0));
+  EXPECT_EQ(r.obstacles[0].accelerations[1].from_s, 1.25);
+  EXPECT_TRUE(r.obstacles[1].accelerations.empty());
   EXPECT_EQ(r.frames, s.frames);
   EXPECT_EQ(r.camera.width, 161);
   EXPECT_EQ(r.camera.height, 121);

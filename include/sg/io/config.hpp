@@ -1,6 +1,7 @@
 #pragma once
 /// The YAML configuration file: mirrors the command-line flags (README "Configuration").
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "sg/core/params.hpp"
@@ -21,7 +22,14 @@ struct RunSettings {
   double scale = 1.0;     ///< `scale:` resize factor of the input images (run --scale)
   std::string csv;        ///< `csv:` per-frame metrics CSV file, empty = none (--csv)
   std::string dump;       ///< `dump:` folder of per-frame PNGs, empty = none (--dump)
+  /// `platform:` preset name (core::apply_platform); read here, applied by the caller before the
+  /// file's other keys (see config_platform).
+  std::string platform;
 };
+
+/// The `platform:` key of a config file, if it has one (for applying the preset first). Throws
+/// core::InputError like apply_config_file for a missing file or bad YAML.
+std::optional<std::string> config_platform(const std::filesystem::path& path);
 
 /// Overwrites the fields of `params` (and `settings`) that the file sets; others keep their value.
 /// Sections: mode, fps, stereo, label, envelope, signal, flow, scene_flow (with scene_flow.ground)

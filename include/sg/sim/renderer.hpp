@@ -14,16 +14,25 @@ struct RenderedFrame {
 };
 
 /// Ground-truth collision test of one box at time t_s (DESIGN 4), relative to the moving camera
-/// with constant relative velocity V = velocity - ego_velocity: with Z_near the depth of the box's
+/// with constant relative velocity V = box_velocity(t_s) - ego_velocity (a box that accelerates
+/// is extrapolated at its current velocity, as a TTC is defined): with Z_near the depth of the box's
 /// nearest face, t_c = (Z_near - z_contact) / (-V_z) when V_z < 0; the box collides when
 /// 0 < t_c <= horizon and at t_c its X extent overlaps [-half_width, half_width] and its Y extent
 /// overlaps [y_top, y_bottom]. A box already at the contact depth (Z_near <= z_contact, Z_far >= 0)
 /// that overlaps the envelope now collides with TTC 0. ttc_s is set only when colliding.
+/// With a turning camera (camera_motion.rotates()) the test runs in the camera frame: the future
+/// is stepped every 1 ms up to the horizon (box at its current velocity, camera on its path and
+/// rotation), and the first instant where the box's bounds in that instant's camera frame reach
+/// the contact depth (Z_near <= z_contact, Z_far >= 0) while overlapping the envelope's X and Y
+/// extents is the contact; a camera turning in place thus never collides with what it does not
+/// already touch.
 core::ObstacleTruth box_collision(const Scenario& s, const Box& box, double t_s);
 
 /// Pure function of (scenario, frame index): rendering frame i never depends on other frames.
-/// Pixel (x, y) looks along ((x - cx) / f, (y - cy) / f, 1); the left camera sits at
-/// ego_velocity * t, the right one baseline_m further along +X. Rows are rendered with
+/// Pixel (x, y) looks along R(t) ((x - cx) / f, (y - cy) / f, 1) (R = camera_rotation); the left
+/// camera sits at ego_velocity * t, the right one baseline_m further along the camera's X axis.
+/// GT disparity = f B / Z with Z the depth in the camera frame; GT backward flow = the pixel of the
+/// same surface point in the previous frame's camera (its pose and rotation then). Rows are rendered with
 /// cv::parallel_for_; the output does not depend on the thread count.
 class Renderer {
  public:
@@ -48,6 +57,8 @@ class ScenarioSource : public core::FrameSource {
   int size() const override;
   /// Ground truth of the frame last returned by next().
   const core::FrameTruth& last_truth() const { return last_.truth; }
+  /// The scenario rendered.
+  const Scenario& scenario() const { return renderer_.scenario(); }
   const core::TruthMaps& last_maps() const { return last_.maps; }
 
  private:

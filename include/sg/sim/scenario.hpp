@@ -1,7 +1,7 @@
 #pragma once
 /// Scenarios for the simulator (DESIGN 4): a camera, a textured ground and background, and boxes.
 /// World frame = the camera frame at t = 0 (x right, y down, z forward, metres); the camera moves
-/// with ego_velocity; the ground is the plane Y = height_m.
+/// with ego_velocity and may turn (CameraMotion); the ground is the plane Y = height_m.
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <string>
@@ -12,13 +12,47 @@
 
 namespace sg::sim {
 
+/// From time from_s on (until the next phase), the box accelerates at acceleration_mps2.
+struct AccelerationPhase {
+  double from_s = 0.0;                   ///< start of the phase, s (phases in increasing order)
+  cv::Vec3d acceleration_mps2{0, 0, 0};  ///< world frame, m/s^2
+};
+
+/// An axis-aligned box (world frame). A pole is a narrow box from the ground up; an overhang is a
+/// box whose bottom is above the ground (nothing below it).
 struct Box {
   int id = 1;                          ///< >= 1, unique; written to the ids map
   cv::Vec3d size_m{1.0, 1.5, 0.5};     ///< width (X), height (Y), depth (Z), m
   cv::Vec3d position_m{0, 0, 15};      ///< centre at t = 0, world frame, m
-  cv::Vec3d velocity_mps{0, 0, 0};     ///< constant, world frame, m/s
+  cv::Vec3d velocity_mps{0, 0, 0};     ///< velocity at t = 0, world frame, m/s
+  /// Piecewise-constant acceleration (empty: constant velocity); before the first phase, none.
+  std::vector<AccelerationPhase> accelerations;
   std::uint32_t texture_seed = 1;      ///< texture fixed to the box
 };
+
+/// Centre of the box at time t_s, world frame, m (integrates the acceleration phases exactly).
+cv::Vec3d box_position(const Box& box, double t_s);
+/// Velocity of the box at time t_s, world frame, m/s.
+cv::Vec3d box_velocity(const Box& box, double t_s);
+
+/// The camera's own rotation (the left camera turns about its optical centre). Camera-to-world
+/// rotation at time t: R(t) = R_y(yaw) R_x(pitch) R_z(roll), with yaw = yaw_rate * t (positive
+/// turns right: the optical axis swings towards +X), pitch = pitch_amplitude sin(2 pi f t)
+/// (positive looks up), roll = roll_amplitude sin(2 pi f t + pi/2), f = oscillation_hz: a
+/// walking or flying platform. All zero (the default): the camera keeps the world axes.
+struct CameraMotion {
+  double yaw_rate_dps = 0.0;         ///< deg/s
+  double pitch_amplitude_deg = 0.0;  ///< deg
+  double roll_amplitude_deg = 0.0;   ///< deg
+  double oscillation_hz = 1.0;       ///< Hz, > 0
+  /// True when any rotation is set.
+  bool rotates() const {
+    return yaw_rate_dps != 0.0 || pitch_amplitude_deg != 0.0 || roll_amplitude_deg != 0.0;
+  }
+};
+
+/// Camera-to-world rotation of the camera at time t_s (see CameraMotion).
+cv::Matx33d camera_rotation(const CameraMotion& m, double t_s);
 
 struct Scenario {
   std::string name;
@@ -26,6 +60,11 @@ struct Scenario {
   core::Camera camera;                    ///< 640x480, f 500 px, B 0.12 m, 30 fps by default
   double height_m = 1.2;                  ///< camera height above the ground, m
   cv::Vec3d ego_velocity_mps{0, 0, 0};    ///< camera velocity, world frame, m/s
+  CameraMotion camera_motion;             ///< the camera's own rotation (default: none)
+  /// Platform preset the scenario is made for ("" = none, "robot", "walker", "car";
+  /// core::platform_names()): `run` and `eval` apply its detector settings unless --platform or
+  /// the config's `platform` key chooses another.
+  std::string platform;
   int frames = 150;                       ///< frames to render
   double background_z_m = 40.0;           ///< textured wall facing the camera at this depth, m
   /// Height of that wall above the ground, m; rays passing above it see a uniform sky (disparity 0).

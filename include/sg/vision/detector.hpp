@@ -34,7 +34,8 @@ struct FrameMaps {
 };
 
 /// The depth-edge mask the Stereo-Flow labelling uses for `disparity` (mark_depth_edges with the
-/// scene_flow edge settings); CV_8U.
+/// scene_flow edge settings, thin structures given back with keep_thin_structures,
+/// vision/edge_margin.hpp); CV_8U.
 void depth_edges(const core::DetectorParams& params, const cv::Mat& disparity, cv::Mat& edges);
 
 /// The per-pixel labelling of one frame, made by Detector::prepare: read-only shares of the maps
@@ -60,6 +61,9 @@ class LabelJob {
   std::vector<cv::Mat> past_edges_;  ///< their depth edges (Stereo-Flow)
   std::vector<int> steps_;           ///< Stereo-Flow: flows chained to past_[j]; Stereo: gap frames
   std::vector<double> spans_s_;      ///< Stereo-Flow: time from past_[j] to now, s
+  /// Stereo-Flow with scene_flow.compensate_rotation: turns past_[j]'s camera coordinates into
+  /// the current orientation; empty = no compensation.
+  std::vector<cv::Matx33d> derotations_;
   cv::Mat danger_, ttc_, velocity_;
 };
 
@@ -76,13 +80,16 @@ class Detector {
   /// arrived frame at most k camera frames back (at least the previous arrived one), following
   /// the flows between them, over the real time between their time_s stamps
   /// (label_stereo_flow_rows). A dropped frame thus shortens the chains instead of restarting
-  /// them; an empty maps.flow cuts the chain there. Throws core::InputError when the disparity is
+  /// them; an empty maps.flow cuts the chain there. With scene_flow.compensate_rotation the
+  /// camera's rotation is estimated from each flow (estimate_ego_motion) and removed over every
+  /// gap. Throws core::InputError when the disparity is
   /// not a non-empty CV_32F map, when a non-empty flow is not CV_32FC2 of its size, when the size
   /// changes within the stream, or when frames come out of order.
   LabelJob prepare(const core::StereoFrame& frame, FrameMaps maps);
 
   /// Turns a labelled frame into its Detection: in Stereo-Flow mode with
-  /// scene_flow.exclude_ground, dangerous pixels on or below a ground plane fitted to D_i are
+  /// scene_flow.grow_into_edges the dangerous blobs grow back over the depth-edge margin
+  /// (grow_danger_into_edges); with scene_flow.exclude_ground, dangerous pixels on or below a ground plane fitted to D_i are
   /// cleared; then obstacles (with the mean 3D velocity in Stereo-Flow mode) tracked over frames
   /// with their TTC from a fit (ObstacleTracker), region counts, hysteresis, severity (held by
   /// SeverityHold) and steering. Fills frame and time_s from `frame`, danger = the cleaned
@@ -100,6 +107,9 @@ class Detector {
     cv::Mat disparity;
     cv::Mat edges;  ///< Stereo-Flow
     cv::Mat flow;   ///< Stereo-Flow: its flow to the next older entry; empty = chain cut
+    /// With compensate_rotation: turns the next older entry's camera coordinates into this
+    /// entry's orientation (from `flow`, estimate_ego_motion).
+    cv::Matx33d derotation = cv::Matx33d::eye();
   };
 
   core::DetectorParams params_;

@@ -85,6 +85,10 @@ struct GapSource {
   const cv::Mat* disparity = nullptr;  ///< D of that past frame, CV_32F, invalid < 0
   const cv::Mat* edges = nullptr;      ///< its mark_depth_edges, or null (checked at q only)
   double span_s = 0.0;                 ///< time from that frame to the current one, s (> 0)
+  /// Turns camera coordinates of that past frame into the current frame's orientation (the
+  /// camera's own rotation over the gap, vision/ego_motion.hpp), applied to P_{i-k} before V is
+  /// formed; null = no rotation.
+  const cv::Matx33d* derotate = nullptr;
 };
 
 /// Allocates the outputs of label_stereo_flow_rows at `size` (danger CV_8U, ttc CV_32F, velocity
