@@ -19,7 +19,7 @@ function(sg_fuzz_target name)
   set(artifacts ${PROJECT_BINARY_DIR}/fuzz/artifacts)
   file(MAKE_DIRECTORY ${work} ${artifacts})
   add_test(NAME ${target}
-    COMMAND ${target} -runs=${SG_FUZZ_RUNS} -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
+    COMMAND ${target} -runs=${SG_FUZZ_RUNS} -timeout=60 -rss_limit_mb=2048 -print_final_stats=1
             -artifact_prefix=${artifacts}/${name}- ${work} ${SG_FUZZ_SOURCE_DIR}/corpus/${name})
   set_tests_properties(${target} PROPERTIES LABELS fuzz
     ENVIRONMENT "ASAN_OPTIONS=detect_leaks=1;UBSAN_OPTIONS=print_stacktrace=1")

@@ -22,7 +22,7 @@ for t in "${targets[@]}"; do
   mkdir -p "build/fuzz/corpus/$t" build/fuzz/artifacts
   echo "== fuzz_$t: $runs runs"
   start=$(date +%s)
-  if ! nice -n 19 "build/fuzz/tests/fuzz/fuzz_$t" -runs="$runs" -timeout=10 -rss_limit_mb=2048 \
+  if ! nice -n 19 "build/fuzz/tests/fuzz/fuzz_$t" -runs="$runs" -timeout=60 -rss_limit_mb=2048 \
       -print_final_stats=1 -artifact_prefix="build/fuzz/artifacts/$t-" \
       "build/fuzz/corpus/$t" "tests/fuzz/corpus/$t" 2>"build/fuzz/$t.log"; then
     status=1
