@@ -82,11 +82,28 @@ struct Result {
   int frames_out = 0;       ///< detections delivered to the sink
   int out_of_order = 0;     ///< detections or events whose frame was not the next expected one
   int dropped = 0;          ///< RunSummary::dropped
+  int warmup_frames = 0;    ///< Config::warmup
   long baseline_kib = 0;    ///< resident memory at the end of the warm-up
   long peak_after_kib = 0;  ///< largest sample after the warm-up
   std::vector<std::pair<int, long>> samples;  ///< (frames done, resident KiB)
   RunSummary summary;
-  long growth_kib() const { return peak_after_kib - baseline_kib; }
+  /// Trend after the warm-up: mean of the last quarter of the samples taken after it minus the
+  /// mean of the first quarter, KiB. Means rather than single samples, so that the allocator
+  /// handing pages back and forth (a spike of a few MiB that goes away) is not taken for a leak,
+  /// while a leak of L bytes per frame shows as about L * 3/4 * (frames - warm-up).
+  long growth_kib() const {
+    std::vector<long> after;
+    for (const auto& [frames, kib] : samples)
+      if (frames > warmup_frames) after.push_back(kib);
+    if (after.size() < 4) return peak_after_kib - baseline_kib;
+    const std::size_t q = after.size() / 4;
+    double first = 0, last = 0;
+    for (std::size_t i = 0; i < q; ++i) {
+      first += after[i];
+      last += after[after.size() - 1 - i];
+    }
+    return static_cast<long>((last - first) / static_cast<double>(q));
+  }
 };
 
 /// The head-on scenario with its camera scaled to width x height, `loop` frames rendered once.
@@ -118,6 +135,8 @@ inline Result run_soak(const Config& c, const std::function<void()>& per_frame =
       std::max(1, static_cast<int>(o.params.signal.region_min_px * area));
   LoopSource source(clip, camera, c.frames);
   Result r;
+  r.warmup_frames = c.warmup;
+  r.warmup_frames = c.warmup;
   r.samples.emplace_back(0, resident_kib());
   r.summary = run(source, o, [&](const core::StereoFrame& f, const core::Detection& d) {
     // One event per frame, in order: the detection, its frame and its JSON event line all carry

@@ -40,11 +40,11 @@ TEST(SoakHarness, CountsEveryFrameInOrder) {
 TEST(SoakHarness, SeesALeak) {
   const Config c = short_config();
   // 64 KiB kept per frame, touched so that it is resident: 300 frames after the warm-up leak
-  // ~19 MiB, far beyond any allocator noise.
+  // ~19 MiB; the quarter means of the samples (150..400) are ~200 frames = ~12 MiB apart.
   std::vector<std::unique_ptr<std::vector<char>>> leak;
   const Result r =
       run_soak(c, [&] { leak.push_back(std::make_unique<std::vector<char>>(65536, 1)); });
-  EXPECT_GT(r.growth_kib(), 15 * 1024);
+  EXPECT_GT(r.growth_kib(), 8 * 1024);
 }
 
 }  // namespace
