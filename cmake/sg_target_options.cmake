@@ -9,6 +9,11 @@ endif()
 if(SG_TSAN)
   list(APPEND SG_SANITIZE_FLAGS -fsanitize=thread)
 endif()
+if(SG_FUZZ)
+  # Coverage for libFuzzer in every library; the fuzz targets add -fsanitize=fuzzer at link time.
+  list(APPEND SG_SANITIZE_FLAGS -fsanitize=fuzzer-no-link,address,undefined
+       -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+endif()
 
 function(sg_target_options target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic ${SG_SANITIZE_FLAGS})

@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs every test (unit, slow, data; data tests skip when
-# ../shared is absent), then the skeleton and pipeline tests again under ThreadSanitizer.
+# ../shared is absent), then the skeleton and pipeline tests again under ThreadSanitizer, then the
+# whole suite under AddressSanitizer + UndefinedBehaviorSanitizer (LeakSanitizer reports fail).
+# The soak (label soak) and the fuzz targets (preset fuzz) are not part of it: see README
+# "Sanitizers, fuzzing, soak".
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs="$(nproc)"
@@ -12,3 +15,8 @@ ctest --preset release -j "$jobs"
 cmake --preset tsan >/dev/null
 cmake --build --preset tsan -j "$jobs" --target test_par test_pipeline
 ctest --preset tsan -L tsan -j "$jobs"
+
+# ASan + UBSan build of everything; every test (the preset leaves out the soak).
+cmake --preset asan >/dev/null
+cmake --build --preset asan -j "$jobs"
+ctest --preset asan -j "$jobs"

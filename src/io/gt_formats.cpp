@@ -70,6 +70,17 @@ cv::Mat read_flo(const std::filesystem::path& path) {
     throw core::InputError("absurd .flo dimensions " + std::to_string(w) + "x" +
                            std::to_string(h) + ": " + path.string());
   }
+  // Compare with the file's size before allocating: a 20-byte file must not claim (and get) 1.6 GB.
+  const std::uintmax_t expected = sizeof header + std::uintmax_t{8} *
+                                                      static_cast<std::uint64_t>(w) *
+                                                      static_cast<std::uint64_t>(h);
+  std::error_code ec;
+  const std::uintmax_t actual = std::filesystem::file_size(path, ec);
+  if (!ec && actual < expected) {
+    throw core::InputError("truncated .flo file (" + std::to_string(w) + "x" + std::to_string(h) +
+                           " needs " + std::to_string(expected) + " bytes, the file has " +
+                           std::to_string(actual) + "): " + path.string());
+  }
   cv::Mat flow(h, w, CV_32FC2);
   const std::size_t row_bytes = static_cast<std::size_t>(w) * 2 * sizeof(float);
   std::vector<unsigned char> row(row_bytes);
@@ -110,6 +121,17 @@ void write_flo(const std::filesystem::path& path, const cv::Mat& flow) {
 cv::Mat read_disparity_png(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path)) {
     throw core::InputError("disparity PNG not found: " + path.string());
+  }
+  // cv::imread picks a decoder by content, not by name: without this check a TIFF, EXR or
+  // JPEG 2000 file named .png would be decoded (and a 16-bit TIFF accepted as a disparity map).
+  {
+    static constexpr unsigned char kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    unsigned char head[sizeof kPngSignature] = {};
+    std::ifstream in(path, std::ios::binary);
+    in.read(reinterpret_cast<char*>(head), sizeof head);
+    if (in.gcount() != sizeof head || std::memcmp(head, kPngSignature, sizeof head) != 0) {
+      throw core::InputError("not a PNG file (bad signature): " + path.string());
+    }
   }
   cv::Mat raw;
   try {

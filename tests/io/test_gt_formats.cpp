@@ -135,6 +135,34 @@ TEST(DisparityPng, RoundTripWithin1Over256AndUnknownKept) {
   }
 }
 
+// Found by fuzz_flo (timeout): a 19-byte file whose header claims 12159x16496 made the reader
+// allocate 1.6 GB before noticing the data was missing. The size check now comes first.
+TEST(Flo, LargeHeaderOnASmallFileIsRejectedBeforeAllocating) {
+  ScratchDir tmp;
+  const fs::path file = tmp.path() / "fuzz.flo";
+  const unsigned char bytes[] = {'P',  'I',  'E',  'H',  0x7f, 0x2f, 0x00, 0x00, 0x70, 0x40,
+                                 0x00, 0x00, 0x50, 0x49, 0x6a, 0x82, 0x48, 0x03, 0x00};
+  std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(bytes), sizeof bytes);
+  const std::string msg = input_error_of([&] { read_flo(file); });
+  EXPECT_NE(msg.find("12159x16496 needs 1604598924 bytes, the file has 19"), std::string::npos)
+      << msg;
+}
+
+// Found by fuzz_disparity_png: cv::imread decodes by content, so any format OpenCV knows (TIFF,
+// JPEG 2000, EXR...) was decoded from a file the user gave as a disparity PNG, and a 16-bit TIFF
+// was accepted as one.
+TEST(DisparityPng, RejectsAnotherFormatNamedPng) {
+  if (!cv::haveImageWriter(".tiff")) GTEST_SKIP() << "OpenCV without TIFF";
+  ScratchDir tmp;
+  const fs::path tiff = tmp.path() / "d.tiff";
+  ASSERT_TRUE(cv::imwrite(tiff.string(), cv::Mat(5, 7, CV_16UC1, cv::Scalar(300))));
+  const fs::path file = tmp.path() / "d.png";
+  fs::rename(tiff, file);
+  const std::string msg = input_error_of([&] { read_disparity_png(file); });
+  EXPECT_NE(msg.find("not a PNG file"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
+}
+
 TEST(DisparityPng, RejectsEightBitPng) {
   ScratchDir tmp;
   const fs::path file = tmp.path() / "d8.png";
