@@ -30,6 +30,9 @@ cv::VideoCapture open_file(const std::string& path) {
 }
 
 cv::VideoCapture open_device(int index) {
+  // OpenCV's V4L2 backend waits 10 s per read for a camera that stopped sending; 2 s is plenty to
+  // call it stuck (read once per process, before the first capture; a user's setting wins).
+  ::setenv("OPENCV_VIDEOIO_V4L_SELECT_TIMEOUT", "2", 0);
   const std::string device = "/dev/video" + std::to_string(index);
   std::error_code ec;
   if (index < 0 || !std::filesystem::exists(device, ec)) {
@@ -52,6 +55,17 @@ int declared_frames(cv::VideoCapture& capture) {
   return std::isfinite(n) && n > 0 && n < 1e9 ? static_cast<int>(n) : -1;
 }
 
+double steady_now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// The capture stamp of the frame just grabbed, s: V4L2's buffer time (CLOCK_MONOTONIC, the
+/// steady clock on Linux), or `now_s` when the driver gives none or an implausible one.
+double capture_stamp(cv::VideoCapture& capture, double now_s) {
+  const double s = capture.get(cv::CAP_PROP_POS_MSEC) / 1000.0;
+  return std::isfinite(s) && s > 0.0 && s <= now_s && now_s - s < 5.0 ? s : now_s;
+}
+
 /// The two halves of a side-by-side frame (even width).
 void split_halves(const cv::Mat& sbs, cv::Mat& left, cv::Mat& right) {
   const int half = sbs.cols / 2;
@@ -60,6 +74,17 @@ void split_halves(const cv::Mat& sbs, cv::Mat& left, cv::Mat& right) {
 }
 
 }  // namespace
+
+int LiveFrameClock::index_of(double stamp_s) {
+  if (last_ < 0) {
+    first_ = stamp_s;
+    last_ = 0;
+    return 0;
+  }
+  const long periods = std::lround((stamp_s - first_) / period_s_);
+  last_ = static_cast<int>(std::max<long>(last_ + 1L, periods));
+  return last_;
+}
 
 std::unique_ptr<CaptureSource> CaptureSource::open_videos(const std::string& left,
                                                           const std::string& right,
@@ -87,19 +112,21 @@ std::unique_ptr<CaptureSource> CaptureSource::open_cameras(int left, int right,
 
 CaptureSource::CaptureSource(std::vector<Capture> captures, bool live, const core::Camera& camera)
     : captures_(std::move(captures)), live_(live), camera_(camera) {
-  start_ = std::chrono::steady_clock::now();
   for (auto& c : captures_) c.declared_frames = live_ ? -1 : declared_frames(c.capture);
   const double rate = captures_[0].capture.get(cv::CAP_PROP_FPS);
   if (std::isfinite(rate) && rate > 0 && rate < core::kMaxFps) camera_.fps = rate;
+  clock_ = LiveFrameClock(camera_.fps);
   if (!live_) {
     frame_count_ = captures_[0].declared_frames;
     if (captures_.size() == 2 && captures_[1].declared_frames >= 0 && frame_count_ >= 0) {
       frame_count_ = std::min(frame_count_, captures_[1].declared_frames);
     }
   }
-  if (!grab(first_)) {
+  if (live_) {
+    first_stamp_s_ = grab_newest(first_);
+  } else if (!grab(first_)) {
     throw core::InputError("cannot read a frame from " + captures_[0].name +
-                           (live_ ? " (the camera gives no image)" : " (empty or corrupt video)"));
+                           " (empty or corrupt video)");
   }
   cv::Size size = first_[0].size();
   if (captures_.size() == 1) {
@@ -128,7 +155,6 @@ bool CaptureSource::grab(std::vector<cv::Mat>& frames) {
   }
   for (size_t k = 0; k < captures_.size(); ++k) {
     if (got[k]) continue;
-    if (live_) throw core::InputError("camera " + captures_[k].name + " stopped giving images");
     // A video that stops well before the length its container states is broken.
     if (captures_[k].declared_frames > 0 && next_index_ + 1 < captures_[k].declared_frames) {
       throw core::InputError(
@@ -147,19 +173,56 @@ bool CaptureSource::grab(std::vector<cv::Mat>& frames) {
   return true;
 }
 
+double CaptureSource::grab_newest(std::vector<cv::Mat>& frames) {
+  constexpr int kMaxStale = 16;  // more frames than any driver queues
+  auto fail = [](const Capture& c) {
+    return core::InputError("camera " + c.name + " gives no image (stopped, unplugged or busy)");
+  };
+  double stamp = 0.0;
+  for (int stale = 0;; ++stale) {
+    // grab() only dequeues (both cameras as close together as possible); decoding waits for the
+    // frame that is kept.
+    for (Capture& c : captures_) {
+      bool ok = false;
+      try {
+        ok = c.capture.grab();
+      } catch (const cv::Exception&) {
+      }
+      if (!ok) throw fail(c);
+    }
+    const double now = steady_now_s();
+    stamp = capture_stamp(captures_[0].capture, now);
+    if (stale == kMaxStale || !clock_.stale(stamp, now)) break;
+  }
+  frames.assign(captures_.size(), cv::Mat());
+  for (size_t k = 0; k < captures_.size(); ++k) {
+    bool ok = false;
+    try {
+      ok = captures_[k].capture.retrieve(frames[k]) && !frames[k].empty();
+    } catch (const cv::Exception&) {
+    }
+    if (!ok) throw fail(captures_[k]);
+  }
+  return stamp;
+}
+
 std::optional<core::PendingFrame> CaptureSource::next_pending() {
   std::vector<cv::Mat> frames;
+  double stamp = 0.0;
   if (next_index_ == 0) {
     frames = std::move(first_);
+    stamp = first_stamp_s_;
+  } else if (live_) {
+    stamp = grab_newest(frames);
   } else if (!grab(frames)) {
     return std::nullopt;
   }
-  const int i = next_index_++;
+  // A camera's index counts its frames from the stamps, so a frame lost is a gap.
+  const int i = live_ ? clock_.index_of(stamp) : next_index_;
+  ++next_index_;
   core::PendingFrame pending;
   pending.index = i;
-  pending.time_s =
-      live_ ? std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count()
-            : i / camera_.fps;
+  pending.time_s = live_ ? stamp - clock_.first_stamp() : i / camera_.fps;
   pending.load = [frames = std::move(frames), i, t = pending.time_s,
                   size = cv::Size(camera_.width, camera_.height), name = captures_[0].name] {
     core::StereoFrame frame;

@@ -76,14 +76,14 @@ class Emitter {
 
   std::optional<FrameJob> operator()() {
     const par::TimePoint begin = par::now();
-    std::optional<core::PendingFrame> frame = source_.next_pending();
+    std::optional<core::PendingFrame> frame = read();
     if (!frame) return std::nullopt;
     if (pace_fps_ > 0) {
       // A camera overwrites a frame nobody took before the next one arrived: while the successor
       // of this frame has been captured already, this frame is lost (dropped) and the successor
       // takes its place. The last frame of a stream has no successor and is never dropped.
       while (capture_time(emitted_ + dropped_ + 1) <= par::now()) {
-        std::optional<core::PendingFrame> successor = source_.next_pending();
+        std::optional<core::PendingFrame> successor = read();
         if (!successor) break;
         ++dropped_;
         frame = std::move(successor);
@@ -104,11 +104,21 @@ class Emitter {
     return job;
   }
 
-  int dropped() const { return dropped_; }
+  /// Frames lost: dropped here, or missing from the source's indices (a live camera's drops).
+  int dropped() const { return dropped_ + lost_; }
   double busy_ms() const { return busy_ms_; }
   void start(par::TimePoint t0) { t0_ = t0; }
 
  private:
+  std::optional<core::PendingFrame> read() {
+    std::optional<core::PendingFrame> frame = source_.next_pending();
+    if (frame) {
+      if (last_index_ >= 0) lost_ += std::max(0, frame->index - last_index_ - 1);
+      last_index_ = frame->index;
+    }
+    return frame;
+  }
+
   /// When the paced camera captures its n-th frame.
   par::TimePoint capture_time(int n) const {
     return t0_ + std::chrono::duration_cast<par::Clock::duration>(
@@ -120,6 +130,7 @@ class Emitter {
   par::TimePoint t0_;
   std::shared_ptr<LazyFrame> previous_;
   int emitted_ = 0, dropped_ = 0;
+  int lost_ = 0, last_index_ = -1;
   double busy_ms_ = 0.0;
 };
 

@@ -234,6 +234,24 @@ TEST(CaptureSource, VideoNextEqualsPendingLoadAndIsLossless) {
   }
 }
 
+TEST(LiveFrameClock, IndicesCountCameraFramesFromTheStamps) {
+  LiveFrameClock clock(20.0);  // 50 ms frames
+  EXPECT_EQ(clock.index_of(100.000), 0);
+  EXPECT_DOUBLE_EQ(clock.first_stamp(), 100.0);
+  EXPECT_EQ(clock.index_of(100.051), 1);  // jitter rounds to the nearest frame
+  EXPECT_EQ(clock.index_of(100.199), 4);  // frames 2 and 3 were lost: a gap of two
+  EXPECT_EQ(clock.index_of(100.210), 5);  // too early for frame 5 still moves on, never repeats
+  EXPECT_EQ(clock.index_of(100.190), 6);  // nor goes back
+}
+
+TEST(LiveFrameClock, AFrameIsStaleOnceItsSuccessorHasBeenCaptured) {
+  const LiveFrameClock clock(20.0);
+  EXPECT_FALSE(clock.stale(10.0, 10.0));
+  EXPECT_FALSE(clock.stale(10.0, 10.049));
+  EXPECT_TRUE(clock.stale(10.0, 10.050));
+  EXPECT_TRUE(clock.stale(10.0, 10.5));
+}
+
 TEST(CaptureSource, MissingCameraIsAnError) {
   EXPECT_NE(input_error_of([] {
               CaptureSource::open_cameras(97, 98, core::Camera{});

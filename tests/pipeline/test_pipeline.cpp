@@ -138,8 +138,12 @@ TEST(Pipeline, StereoFlowStillFiresWithEveryFifthFrameDropped) {
   DroppingSource source(inner, 5);
   RunOptions o = options_for(core::Mode::kStereoFlow);
   int alarms = 0;
-  run(source, o, [&](const core::StereoFrame&, const core::Detection& d) { alarms += d.signal; });
+  const RunSummary s = run(
+      source, o, [&](const core::StereoFrame&, const core::Detection& d) { alarms += d.signal; });
   EXPECT_GT(alarms, 0);
+  // Frames missing from the source's indices (as a live camera's) count as dropped.
+  EXPECT_EQ(s.dropped, source.dropped());
+  EXPECT_EQ(s.frames + s.dropped, static_cast<int>(head_on().frames.size()));
 }
 
 TEST(Pipeline, EmptyStream) {

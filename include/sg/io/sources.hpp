@@ -54,6 +54,33 @@ class ImageListSource : public DeferredSource {
 /// camera. When one of two videos ends before the other the stream stops at the shorter, with one
 /// warning line on stderr. A video that ends well before the frame count its container states
 /// (truncated) or stops decoding is an InputError.
+///
+/// Cameras are live (DESIGN section 1): the camera paces the stream, and a frame that waited in
+/// the driver's queue while the pipeline had no free token is dropped in favour of the newest one
+/// (LiveFrameClock). Frame indices count camera frames from the capture stamps, so every frame
+/// lost, whether here or by the driver, is a gap in them (the pipeline counts it as dropped). A
+/// camera that stops giving images is an InputError after a few seconds, not a hang.
+/// The frame policy of a live camera at `fps` (pure, for testing): which camera frame a capture
+/// stamp is, and whether a grabbed frame is stale (its successor has been captured already).
+class LiveFrameClock {
+ public:
+  explicit LiveFrameClock(double fps = 30.0) : period_s_(1.0 / fps) {}
+  /// Camera frame number of a frame captured at `stamp_s` (the first call is frame 0): the
+  /// rounded number of periods since the first stamp, and always above the previous result (a
+  /// jittery stamp never repeats or reverses an index).
+  int index_of(double stamp_s);
+  /// True when a frame captured at `stamp_s` is stale at `now_s`: one period or more has passed,
+  /// so the camera has captured a newer frame, which waits in the driver's queue.
+  bool stale(double stamp_s, double now_s) const { return now_s - stamp_s >= period_s_; }
+  /// Capture stamp of the first frame, s.
+  double first_stamp() const { return first_; }
+
+ private:
+  double period_s_;
+  double first_ = 0.0;
+  int last_ = -1;
+};
+
 class CaptureSource : public DeferredSource {
  public:
   /// Two video files. `camera` gives focal, baseline, cx, cy, and fps when the videos have none.
@@ -79,8 +106,11 @@ class CaptureSource : public DeferredSource {
     int declared_frames = -1;  ///< the container's frame count, -1 unknown
   };
   CaptureSource(std::vector<Capture> captures, bool live, const core::Camera& camera);
-  /// Grabs one frame of every capture; false at the end of the stream.
+  /// Reads one frame of every capture; false at the end of the stream.
   bool grab(std::vector<cv::Mat>& frames);
+  /// Live: grabs the newest frame of every camera (dropping queued stale ones) and decodes it;
+  /// returns its capture stamp, s on the steady clock.
+  double grab_newest(std::vector<cv::Mat>& frames);
 
   std::vector<Capture> captures_;
   bool live_;
@@ -88,7 +118,8 @@ class CaptureSource : public DeferredSource {
   int frame_count_ = -1;
   int next_index_ = 0;
   std::vector<cv::Mat> first_;  ///< the first frame, read by the constructor to learn the size
-  std::chrono::steady_clock::time_point start_;
+  double first_stamp_s_ = 0.0;  ///< live: capture stamp of first_
+  LiveFrameClock clock_;        ///< live only
 };
 
 /// Decorator: rectifies the frames of `inner` with maps computed once from a raw calibration.

@@ -45,7 +45,9 @@ int effective_tokens(const RunOptions& options);
 /// The run's metrics (DESIGN 1, "Metrics").
 struct RunSummary {
   int frames = 0;   ///< detections produced
-  int dropped = 0;  ///< frames the paced emitter had to skip
+  /// Frames lost: skipped by the paced emitter, or missing from the source's frame indices (a
+  /// live camera's drops, DroppingSource).
+  int dropped = 0;
   int alarm_frames = 0;
   std::optional<int> first_alarm_frame;
   std::optional<double> first_alarm_time_s;
