@@ -43,6 +43,8 @@ struct FastJob {
   size_t texture_step = 0;
   std::uint16_t* v = nullptr;   ///< scratch: column sums, (width - xb) x num_disp, aligned
   std::uint16_t* s = nullptr;   ///< scratch: block sums of one row, output columns x num_disp
+  std::uint16_t* sacc = nullptr;  ///< scratch: running horizontal sums, num_disp, aligned
+  std::uint16_t* cbuf = nullptr;  ///< scratch: one pixel's block sums, num_disp, aligned
   std::int16_t* out = nullptr;  ///< per output row: disparity * 16 or kInvalid16
   size_t out_step = 0;
 };
@@ -71,23 +73,17 @@ HWY_INLINE hn::Vec<D16> CostAt(D16 d16, const FastJob& j, size_t off, int x, int
   }
 }
 
-/// Column sums V[x][d] for the columns x >= xb: adds the costs of input row `add` and, when
-/// sub >= 0, subtracts those of row `sub` (u16 arithmetic is exact modulo 2^16 and the true sums
-/// fit in 16 bits, so the result is exact).
-template <bool kCensus, class D16>
-void UpdateColumns(D16 d16, const FastJob& j, int add, int sub, std::uint16_t* HWY_RESTRICT v) {
+/// Column c (image column xb + c) of the column sums V[c][d]: adds the costs of the input row at
+/// element offset `off_add` and, when kSub, subtracts those of the row at `off_sub` (u16
+/// arithmetic is exact modulo 2^16 and the true sums fit in 16 bits, so the result is exact).
+template <bool kCensus, bool kSub, class D16>
+HWY_INLINE void UpdateColumn(D16 d16, const FastJob& j, size_t off_add, size_t off_sub, int x,
+                             std::uint16_t* HWY_RESTRICT col) {
   const int n = static_cast<int>(hn::Lanes(d16));
-  const int xb = j.min_disp + j.num_disp - 1, nd = j.num_disp;
-  const size_t step = kCensus ? j.step16 : j.step8;
-  const size_t off_add = static_cast<size_t>(add) * step;
-  const size_t off_sub = static_cast<size_t>(sub < 0 ? 0 : sub) * step;
-  for (int x = xb; x < j.width; ++x) {
-    std::uint16_t* dst = v + static_cast<size_t>(x - xb) * nd;
-    for (int d = 0; d < nd; d += n) {
-      auto acc = hn::Add(hn::Load(d16, dst + d), CostAt<kCensus>(d16, j, off_add, x, d));
-      if (sub >= 0) acc = hn::Sub(acc, CostAt<kCensus>(d16, j, off_sub, x, d));
-      hn::Store(acc, d16, dst + d);
-    }
+  for (int d = 0; d < j.num_disp; d += n) {
+    auto acc = hn::Add(hn::Load(d16, col + d), CostAt<kCensus>(d16, j, off_add, x, d));
+    if constexpr (kSub) acc = hn::Sub(acc, CostAt<kCensus>(d16, j, off_sub, x, d));
+    hn::Store(acc, d16, col + d);
   }
 }
 
@@ -114,75 +110,122 @@ HWY_INLINE std::uint16_t MinLane(D16 d16, hn::Vec<D16> v) {
   return hn::GetLane(hn::MinOfLanes(d16, v));
 }
 
-template <bool kCensus, class D16>
-void MatchRowsT(D16 d16, const FastJob& j) {
+/// One row's block sums, winners and checks, fused: for each output pixel the newest column of V
+/// is updated (when kSub: the row moved down by one), added to the running horizontal sums S,
+/// which are reduced at once (winner, uniqueness, sub-pixel) and then lose their oldest column.
+/// kNV: vectors per disparity range (S lives in registers), 0 = any (S in memory).
+template <bool kCensus, bool kSub, int kNV, class D16>
+void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
+  constexpr int kMaxNV = kNV > 0 ? kNV : 1;
   const int n = static_cast<int>(hn::Lanes(d16));
+  const int nd = j.num_disp, h = j.half, nv = kNV > 0 ? kNV : nd / n;
+  const int xb = j.min_disp + nd - 1;  // first column with a full search range
+  const int x0 = xb + h, nout = j.width - h - x0;
+  const size_t step = kCensus ? j.step16 : j.step8;
+  const int row = y - (j.y_begin - h);  // input row of y
+  const size_t off_add = static_cast<size_t>(row + h) * step;
+  const size_t off_sub = static_cast<size_t>(kSub ? row - h - 1 : 0) * step;
+  std::uint16_t* HWY_RESTRICT v = j.v;
+  std::uint16_t* HWY_RESTRICT sacc = j.sacc;  // S when kNV == 0, nd lanes
+  const bool keep = j.lr_max_diff >= 0;       // all block sums of the row kept for the LR check
+  const int u = j.uniqueness;
+
+  hn::Vec<D16> sr[kMaxNV];  // S when kNV > 0
+  for (int k = 0; k < kMaxNV; ++k) sr[k] = hn::Zero(d16);
+  if constexpr (kNV == 0) std::fill(sacc, sacc + nd, std::uint16_t{0});
+  for (int c = 0; c < 2 * h; ++c) {
+    std::uint16_t* col = v + static_cast<size_t>(c) * nd;
+    if constexpr (kSub) UpdateColumn<kCensus, true>(d16, j, off_add, off_sub, xb + c, col);
+    for (int k = 0; k < nv; ++k) {
+      if constexpr (kNV > 0) {
+        sr[k] = hn::Add(sr[k], hn::Load(d16, col + k * n));
+      } else {
+        hn::Store(hn::Add(hn::Load(d16, sacc + k * n), hn::Load(d16, col + k * n)), d16,
+                  sacc + k * n);
+      }
+    }
+  }
+
+  std::int16_t* out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step;
+  const std::uint8_t* tex = j.texture_ok + static_cast<size_t>(y - j.y_begin) * j.texture_step;
+  const int min16 = j.min_disp * 16;
+  for (int i = 0; i < nout; ++i) {
+    std::uint16_t* col = v + static_cast<size_t>(i + 2 * h) * nd;
+    if constexpr (kSub) UpdateColumn<kCensus, true>(d16, j, off_add, off_sub, xb + i + 2 * h, col);
+    // c: this pixel's block sums in memory, for the scalar look-ups below.
+    std::uint16_t* HWY_RESTRICT c = keep ? j.s + static_cast<size_t>(i) * nd : j.cbuf;
+    auto vmin = hn::Set(d16, std::uint16_t{0xFFFF});
+    for (int k = 0; k < nv; ++k) {
+      hn::Vec<D16> sk;
+      if constexpr (kNV > 0) {
+        sr[k] = hn::Add(sr[k], hn::Load(d16, col + k * n));
+        sk = sr[k];
+      } else {
+        sk = hn::Add(hn::Load(d16, sacc + k * n), hn::Load(d16, col + k * n));
+      }
+      hn::Store(sk, d16, c + k * n);
+      vmin = hn::Min(vmin, sk);
+    }
+    // Winner: the first disparity with the smallest sum. Uniqueness: no disparity further than
+    // 1 px from it within the threshold, i.e. the count within it equals the winner's own
+    // neighbourhood's count. Branch-free: which vector holds the winner is unpredictable.
+    const int m = MinLane(d16, vmin);
+    const auto vm = hn::Set(d16, static_cast<std::uint16_t>(m));
+    const int thresh = u > 0 ? std::min(m + m * u / 100, 65535) : 0;
+    const auto vt = hn::Set(d16, static_cast<std::uint16_t>(thresh));
+    int b = 0;
+    size_t count = 0;
+    for (int k = nv - 1; k >= 0; --k) {
+      const auto sk = kNV > 0 ? sr[k] : hn::Load(d16, c + k * n);
+      const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(sk, vm));
+      b = f >= 0 ? k * n + static_cast<int>(f) : b;
+      count += hn::CountTrue(d16, hn::Eq(hn::Min(sk, vt), sk));  // sk <= thresh
+    }
+    const int cm = c[b > 0 ? b - 1 : 0], cp = c[b < nd - 1 ? b + 1 : nd - 1];
+    const size_t near = 1 + static_cast<size_t>(b > 0 && cm <= thresh) +
+                        static_cast<size_t>(b < nd - 1 && cp <= thresh);
+    const bool ok = tex[x0 + i] != 0 && (u <= 0 || count == near);
+    const int d16v = (b > 0 && b < nd - 1) ? subpixel_disparity16(b, cm, m, cp) : b * 16;
+    out[x0 + i] = ok ? static_cast<std::int16_t>(d16v + min16) : kInvalid16;
+    best[i] = b;
+    // The oldest column leaves the window.
+    const std::uint16_t* old = v + static_cast<size_t>(i) * nd;
+    for (int k = 0; k < nv; ++k) {
+      if constexpr (kNV > 0) {
+        sr[k] = hn::Sub(sr[k], hn::Load(d16, old + k * n));
+      } else {
+        hn::Store(hn::Sub(hn::Add(hn::Load(d16, sacc + k * n), hn::Load(d16, col + k * n)),
+                          hn::Load(d16, old + k * n)),
+                  d16, sacc + k * n);
+      }
+    }
+  }
+}
+
+template <bool kCensus, int kNV, class D16>
+void MatchRowsT(D16 d16, const FastJob& j) {
   const int nd = j.num_disp, h = j.half;
-  const int xb = j.min_disp + nd - 1;       // first column with a full search range
+  const int xb = j.min_disp + nd - 1;  // first column with a full search range
   const int x0 = xb + h, x1 = j.width - h;  // output columns
   const int ncols = j.width - xb, nout = x1 - x0;
+  const size_t step = kCensus ? j.step16 : j.step8;
   std::uint16_t* HWY_RESTRICT v = j.v;
-  std::uint16_t* HWY_RESTRICT s = j.s;
   std::vector<int> best(nout);
   std::fill(v, v + static_cast<size_t>(ncols) * nd, std::uint16_t{0});
-  for (int row = 0; row < 2 * h + 1; ++row) UpdateColumns<kCensus>(d16, j, row, -1, v);
+  for (int row = 0; row < 2 * h + 1; ++row)
+    for (int c = 0; c < ncols; ++c)
+      UpdateColumn<kCensus, false>(d16, j, static_cast<size_t>(row) * step, 0, xb + c,
+                                   v + static_cast<size_t>(c) * nd);
 
   for (int y = j.y_begin; y < j.y_end; ++y) {
-    const int row = y - (j.y_begin - h);  // input row of y
-    if (y > j.y_begin) UpdateColumns<kCensus>(d16, j, row + h, row - h - 1, v);
-    // Horizontal box sums, incremental along x.
-    std::uint16_t* s0 = s;
-    for (int d = 0; d < nd; d += n) {
-      auto acc = hn::Zero(d16);
-      for (int k = 0; k < 2 * h + 1; ++k)
-        acc = hn::Add(acc, hn::Load(d16, v + static_cast<size_t>(k) * nd + d));
-      hn::Store(acc, d16, s0 + d);
-    }
-    for (int i = 1; i < nout; ++i) {
-      const std::uint16_t* add = v + static_cast<size_t>(i + 2 * h) * nd;
-      const std::uint16_t* sub = v + static_cast<size_t>(i - 1) * nd;
-      const std::uint16_t* prev = s + static_cast<size_t>(i - 1) * nd;
-      std::uint16_t* cur = s + static_cast<size_t>(i) * nd;
-      for (int d = 0; d < nd; d += n) {
-        const auto sum = hn::Sub(hn::Add(hn::Load(d16, prev + d), hn::Load(d16, add + d)),
-                                 hn::Load(d16, sub + d));
-        hn::Store(sum, d16, cur + d);
-      }
-    }
-    // Winner takes all, uniqueness, texture, sub-pixel.
-    std::int16_t* out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step;
-    const std::uint8_t* tex = j.texture_ok + static_cast<size_t>(y - j.y_begin) * j.texture_step;
-    for (int i = 0; i < nout; ++i) {
-      out[x0 + i] = kInvalid16;
-      if (!tex[x0 + i]) continue;
-      const std::uint16_t* c = s + static_cast<size_t>(i) * nd;
-      auto vmin = hn::Load(d16, c);
-      for (int d = n; d < nd; d += n) vmin = hn::Min(vmin, hn::Load(d16, c + d));
-      const std::uint16_t m = MinLane(d16, vmin);
-      const auto vm = hn::Set(d16, m);
-      int b = -1;
-      size_t count = 0;  // disparities within the uniqueness threshold
-      const int thresh = j.uniqueness > 0 ? std::min(m + m * j.uniqueness / 100, 65535) : -1;
-      const auto vt = hn::Set(d16, static_cast<std::uint16_t>(std::max(thresh, 0)));
-      // Branch-free over the (few) vectors: which vector holds the winner is unpredictable.
-      for (int d = 0; d < nd; d += n) {
-        const auto cv = hn::Load(d16, c + d);
-        const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(cv, vm));
-        b = (b < 0 && f >= 0) ? d + static_cast<int>(f) : b;
-        if (thresh >= 0) count += hn::CountTrue(d16, hn::Eq(hn::Min(cv, vt), cv));
-      }
-      best[i] = b;
-      if (thresh >= 0) {
-        for (int d = std::max(b - 1, 0); d <= std::min(b + 1, nd - 1); ++d)
-          count -= c[d] <= thresh ? 1 : 0;
-        if (count != 0) continue;
-      }
-      const int d16v =
-          (b > 0 && b < nd - 1) ? subpixel_disparity16(b, c[b - 1], c[b], c[b + 1]) : b * 16;
-      out[x0 + i] = static_cast<std::int16_t>(d16v + j.min_disp * 16);
-    }
+    if (y > j.y_begin)
+      MatchRow<kCensus, true, kNV>(d16, j, y, best.data());
+    else
+      MatchRow<kCensus, false, kNV>(d16, j, y, best.data());
     if (j.lr_max_diff >= 0) {
       // Right image's winners: right pixel xr is seen by left pixel xr + min_disp + d at d.
+      const std::uint16_t* s = j.s;
+      std::int16_t* out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step;
       std::vector<int> rbest(j.width, -1), rcost(j.width, INT_MAX);
       for (int i = 0; i < nout; ++i) {
         const std::uint16_t* c = s + static_cast<size_t>(i) * nd;
@@ -204,6 +247,22 @@ void MatchRowsT(D16 d16, const FastJob& j) {
   }
 }
 
+template <bool kCensus, class D16>
+void MatchRowsNV(D16 d16, const FastJob& j) {
+  switch (j.num_disp / static_cast<int>(hn::Lanes(d16))) {
+    case 1:
+      return MatchRowsT<kCensus, 1>(d16, j);
+    case 2:
+      return MatchRowsT<kCensus, 2>(d16, j);
+    case 4:
+      return MatchRowsT<kCensus, 4>(d16, j);
+    case 8:
+      return MatchRowsT<kCensus, 8>(d16, j);
+    default:
+      return MatchRowsT<kCensus, 0>(d16, j);
+  }
+}
+
 /// Full-width vectors when the range is a whole number of them (AVX-512: 32 lanes), else at
 /// most 16 lanes, which every multiple of 16 disparities fills.
 void MatchRows(const FastJob& j) {
@@ -212,14 +271,14 @@ void MatchRows(const FastJob& j) {
   const bool use_full = j.num_disp % static_cast<int>(hn::Lanes(full)) == 0;
   if (j.census) {
     if (use_full)
-      MatchRowsT<true>(full, j);
+      MatchRowsNV<true>(full, j);
     else
-      MatchRowsT<true>(capped, j);
+      MatchRowsNV<true>(capped, j);
   } else {
     if (use_full)
-      MatchRowsT<false>(full, j);
+      MatchRowsNV<false>(full, j);
     else
-      MatchRowsT<false>(capped, j);
+      MatchRowsNV<false>(capped, j);
   }
 }
 
@@ -255,8 +314,8 @@ struct Scratch {
   cv::Mat pl, pr, cl, cr, integral, tex_ok, out16;
   std::vector<std::uint8_t> r8;
   std::vector<std::uint16_t> llo, lhi, rlo, rhi;
-  hwy::AlignedFreeUniquePtr<std::uint16_t[]> v, s;
-  size_t v_size = 0, s_size = 0;
+  hwy::AlignedFreeUniquePtr<std::uint16_t[]> v, s, small;
+  size_t v_size = 0, s_size = 0, small_size = 0;
 };
 
 std::uint16_t* aligned(hwy::AlignedFreeUniquePtr<std::uint16_t[]>& p, size_t& size, size_t need) {
@@ -360,7 +419,10 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
   out16.setTo(kInvalid16);
   const int xb = md + nd - 1;
   job.v = aligned(sc.v, sc.v_size, static_cast<size_t>(width - xb) * nd);
-  job.s = aligned(sc.s, sc.s_size, static_cast<size_t>(width - h - (xb + h)) * nd);
+  if (job.lr_max_diff >= 0)
+    job.s = aligned(sc.s, sc.s_size, static_cast<size_t>(width - h - (xb + h)) * nd);
+  job.sacc = aligned(sc.small, sc.small_size, 2 * static_cast<size_t>(nd));
+  job.cbuf = job.sacc + nd;
   job.out = out16.ptr<std::int16_t>(0);
   job.out_step = out16.step1();
   HWY_DYNAMIC_DISPATCH(MatchRows)(job);
