@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <climits>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "stereo_fast_common.hpp"
@@ -56,33 +57,75 @@ namespace sg::vision::fast_detail {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-/// Pixel costs of input row `off` (element offset of the row) for column x and the disparities
-/// [d, d + Lanes(d16)): |left - right| of the prefiltered images or census Hamming distances.
+/// One input row's pixels as the column updates read them. The right rows are offset so that
+/// r[-x + d] is the right pixel matched with left pixel x at disparity min_disp + d.
+struct RowPtrs {
+  const std::uint8_t* l8 = nullptr;
+  const std::uint8_t* r8 = nullptr;
+  const std::uint16_t *llo = nullptr, *lhi = nullptr, *rlo = nullptr, *rhi = nullptr;
+};
+
+HWY_INLINE RowPtrs RowAt(const FastJob& j, int row) {
+  RowPtrs p;
+  const ptrdiff_t rx = j.width - 1 + j.min_disp;
+  if (j.census) {
+    const size_t off = static_cast<size_t>(row) * j.step16;
+    p.llo = j.left_lo + off;
+    p.lhi = j.left_hi + off;
+    p.rlo = j.right_lo_rev + off + rx;
+    p.rhi = j.right_hi_rev + off + rx;
+  } else {
+    const size_t off = static_cast<size_t>(row) * j.step8;
+    p.l8 = j.left8 + off;
+    p.r8 = j.right8_rev + off + rx;
+  }
+  return p;
+}
+
+/// Pixel costs of left pixel x at the disparities [d, d + Lanes(d16)) of one row: |left - right|
+/// of the prefiltered images or census Hamming distances. `lv`, `lhi`: left pixel broadcast.
 template <bool kCensus, class D16>
-HWY_INLINE hn::Vec<D16> CostAt(D16 d16, const FastJob& j, size_t off, int x, int d) {
-  const size_t rx = off + static_cast<size_t>(j.width - 1 - x + j.min_disp + d);
+HWY_INLINE hn::Vec<D16> CostAt(D16 d16, const RowPtrs& p, hn::Vec<D16> lv, hn::Vec<D16> lhi,
+                               int x, int d) {
   if constexpr (!kCensus) {
     const hn::Rebind<std::uint8_t, D16> d8;
-    const auto lv = hn::Set(d16, j.left8[off + x]);
-    const auto rv = hn::PromoteTo(d16, hn::LoadU(d8, j.right8_rev + rx));
+    const auto rv = hn::PromoteTo(d16, hn::LoadU(d8, p.r8 - x + d));
     return hn::Sub(hn::Max(lv, rv), hn::Min(lv, rv));
   } else {
-    const auto lo = hn::Xor(hn::Set(d16, j.left_lo[off + x]), hn::LoadU(d16, j.right_lo_rev + rx));
-    const auto hi = hn::Xor(hn::Set(d16, j.left_hi[off + x]), hn::LoadU(d16, j.right_hi_rev + rx));
+    const auto lo = hn::Xor(lv, hn::LoadU(d16, p.rlo - x + d));
+    const auto hi = hn::Xor(lhi, hn::LoadU(d16, p.rhi - x + d));
     return hn::Add(hn::PopulationCount(lo), hn::PopulationCount(hi));
   }
 }
 
-/// Column c (image column xb + c) of the column sums V[c][d]: adds the costs of the input row at
-/// element offset `off_add` and, when kSub, subtracts those of the row at `off_sub` (u16
-/// arithmetic is exact modulo 2^16 and the true sums fit in 16 bits, so the result is exact).
-template <bool kCensus, bool kSub, class D16>
-HWY_INLINE void UpdateColumn(D16 d16, const FastJob& j, size_t off_add, size_t off_sub, int x,
+/// Column x of the column sums V[x][d] (`col`): adds the costs of row `a` and, when kSub,
+/// subtracts those of row `s` (u16 arithmetic is exact modulo 2^16 and the true sums fit in 16
+/// bits, so the result is exact). kNV: vectors per disparity range, 0 = nd / Lanes at run time.
+/// Returns the first vector of the updated column (kNV > 0 callers reload the rest from L1).
+template <bool kCensus, bool kSub, int kNV, class D16>
+HWY_INLINE void UpdateColumn(D16 d16, const RowPtrs& a, const RowPtrs& s, int x, int nd,
                              std::uint16_t* HWY_RESTRICT col) {
   const int n = static_cast<int>(hn::Lanes(d16));
-  for (int d = 0; d < j.num_disp; d += n) {
-    auto acc = hn::Add(hn::Load(d16, col + d), CostAt<kCensus>(d16, j, off_add, x, d));
-    if constexpr (kSub) acc = hn::Sub(acc, CostAt<kCensus>(d16, j, off_sub, x, d));
+  hn::Vec<D16> la, ha, ls, hs;
+  if constexpr (kCensus) {
+    la = hn::Set(d16, a.llo[x]);
+    ha = hn::Set(d16, a.lhi[x]);
+    if constexpr (kSub) {
+      ls = hn::Set(d16, s.llo[x]);
+      hs = hn::Set(d16, s.lhi[x]);
+    }
+  } else {
+    la = hn::Set(d16, a.l8[x]);
+    ha = la;
+    if constexpr (kSub) {
+      ls = hn::Set(d16, s.l8[x]);
+      hs = ls;
+    }
+  }
+  const int end = kNV > 0 ? kNV * n : nd;
+  for (int d = 0; d < end; d += n) {
+    auto acc = hn::Add(hn::Load(d16, col + d), CostAt<kCensus>(d16, a, la, ha, x, d));
+    if constexpr (kSub) acc = hn::Sub(acc, CostAt<kCensus>(d16, s, ls, hs, x, d));
     hn::Store(acc, d16, col + d);
   }
 }
@@ -110,10 +153,31 @@ HWY_INLINE std::uint16_t MinLane(D16 d16, hn::Vec<D16> v) {
   return hn::GetLane(hn::MinOfLanes(d16, v));
 }
 
+/// Lane i of the mask as bit i (at most 64 lanes).
+template <class D16>
+HWY_INLINE std::uint64_t MaskBits(D16 d16, hn::Mask<D16> m) {
+#if HWY_TARGET <= HWY_AVX3
+  (void)d16;
+  return static_cast<std::uint64_t>(m.raw);
+#else
+  std::uint8_t bytes[8] = {};
+  hn::StoreMaskBits(d16, m, bytes);
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, bytes, sizeof(bits));
+  return bits;
+#endif
+}
+
+/// Bit p of 64-bit word w of a bitmap (0 when p is in another word or negative).
+HWY_INLINE std::uint64_t BitIn(int w, int p) {
+  return (p >> 6) == w ? std::uint64_t{1} << (p & 63) : 0;
+}
+
 /// One row's block sums, winners and checks, fused: for each output pixel the newest column of V
 /// is updated (when kSub: the row moved down by one), added to the running horizontal sums S,
 /// which are reduced at once (winner, uniqueness, sub-pixel) and then lose their oldest column.
-/// kNV: vectors per disparity range (S lives in registers), 0 = any (S in memory).
+/// kNV: vectors per disparity range, S and the reductions in registers and 64-bit masks; 0 =
+/// any range, S in memory, reduced vector by vector.
 template <bool kCensus, bool kSub, int kNV, class D16>
 void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
   constexpr int kMaxNV = kNV > 0 ? kNV : 1;
@@ -121,10 +185,8 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
   const int nd = j.num_disp, h = j.half, nv = kNV > 0 ? kNV : nd / n;
   const int xb = j.min_disp + nd - 1;  // first column with a full search range
   const int x0 = xb + h, nout = j.width - h - x0;
-  const size_t step = kCensus ? j.step16 : j.step8;
   const int row = y - (j.y_begin - h);  // input row of y
-  const size_t off_add = static_cast<size_t>(row + h) * step;
-  const size_t off_sub = static_cast<size_t>(kSub ? row - h - 1 : 0) * step;
+  const RowPtrs ra = RowAt(j, row + h), rs = RowAt(j, kSub ? row - h - 1 : 0);
   std::uint16_t* HWY_RESTRICT v = j.v;
   std::uint16_t* HWY_RESTRICT sacc = j.sacc;  // S when kNV == 0, nd lanes
   const bool keep = j.lr_max_diff >= 0;       // all block sums of the row kept for the LR check
@@ -135,7 +197,7 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
   if constexpr (kNV == 0) std::fill(sacc, sacc + nd, std::uint16_t{0});
   for (int c = 0; c < 2 * h; ++c) {
     std::uint16_t* col = v + static_cast<size_t>(c) * nd;
-    if constexpr (kSub) UpdateColumn<kCensus, true>(d16, j, off_add, off_sub, xb + c, col);
+    if constexpr (kSub) UpdateColumn<kCensus, true, kNV>(d16, ra, rs, xb + c, nd, col);
     for (int k = 0; k < nv; ++k) {
       if constexpr (kNV > 0) {
         sr[k] = hn::Add(sr[k], hn::Load(d16, col + k * n));
@@ -146,14 +208,17 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
     }
   }
 
-  std::int16_t* out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step;
-  const std::uint8_t* tex = j.texture_ok + static_cast<size_t>(y - j.y_begin) * j.texture_step;
+  std::int16_t* HWY_RESTRICT out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step + x0;
+  const std::uint8_t* HWY_RESTRICT tex =
+      j.texture_ok + static_cast<size_t>(y - j.y_begin) * j.texture_step + x0;
+  std::uint16_t* HWY_RESTRICT s = j.s;
+  std::uint16_t* HWY_RESTRICT cbuf = j.cbuf;
   const int min16 = j.min_disp * 16;
   for (int i = 0; i < nout; ++i) {
-    std::uint16_t* col = v + static_cast<size_t>(i + 2 * h) * nd;
-    if constexpr (kSub) UpdateColumn<kCensus, true>(d16, j, off_add, off_sub, xb + i + 2 * h, col);
+    std::uint16_t* HWY_RESTRICT col = v + static_cast<size_t>(i + 2 * h) * nd;
+    if constexpr (kSub) UpdateColumn<kCensus, true, kNV>(d16, ra, rs, xb + i + 2 * h, nd, col);
     // c: this pixel's block sums in memory, for the scalar look-ups below.
-    std::uint16_t* HWY_RESTRICT c = keep ? j.s + static_cast<size_t>(i) * nd : j.cbuf;
+    std::uint16_t* HWY_RESTRICT c = keep ? s + static_cast<size_t>(i) * nd : cbuf;
     auto vmin = hn::Set(d16, std::uint16_t{0xFFFF});
     for (int k = 0; k < nv; ++k) {
       hn::Vec<D16> sk;
@@ -167,29 +232,47 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
       vmin = hn::Min(vmin, sk);
     }
     // Winner: the first disparity with the smallest sum. Uniqueness: no disparity further than
-    // 1 px from it within the threshold, i.e. the count within it equals the winner's own
-    // neighbourhood's count. Branch-free: which vector holds the winner is unpredictable.
+    // 1 px from it at or below the threshold. Branch-free: where the winner is is unpredictable.
     const int m = MinLane(d16, vmin);
     const auto vm = hn::Set(d16, static_cast<std::uint16_t>(m));
     const int thresh = u > 0 ? std::min(m + m * u / 100, 65535) : 0;
     const auto vt = hn::Set(d16, static_cast<std::uint16_t>(thresh));
     int b = 0;
-    size_t count = 0;
-    for (int k = nv - 1; k >= 0; --k) {
-      const auto sk = kNV > 0 ? sr[k] : hn::Load(d16, c + k * n);
-      const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(sk, vm));
-      b = f >= 0 ? k * n + static_cast<int>(f) : b;
-      count += hn::CountTrue(d16, hn::Eq(hn::Min(sk, vt), sk));  // sk <= thresh
+    bool unique = true;
+    if constexpr (kNV > 0) {
+      constexpr int kWords = (kNV * hn::MaxLanes(d16) + 63) / 64;
+      std::uint64_t eq[kWords] = {}, le[kWords] = {};
+      for (int k = 0; k < kNV; ++k) {
+        const int w = k * n / 64, sh = k * n % 64;
+        eq[w] |= MaskBits(d16, hn::Eq(sr[k], vm)) << sh;
+        le[w] |= MaskBits(d16, hn::Eq(hn::Min(sr[k], vt), sr[k])) << sh;  // sum <= thresh
+      }
+      for (int w = kWords - 1; w >= 0; --w)
+        b = eq[w] != 0 ? w * 64 + static_cast<int>(hwy::Num0BitsBelowLS1Bit_Nonzero64(eq[w])) : b;
+      std::uint64_t far = 0;
+      for (int w = 0; w < kWords; ++w)
+        far |= le[w] & ~(BitIn(w, b - 1) | BitIn(w, b) | BitIn(w, b + 1));
+      unique = far == 0;
+    } else {
+      size_t count = 0;
+      for (int k = nv - 1; k >= 0; --k) {
+        const auto sk = hn::Load(d16, c + k * n);
+        const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(sk, vm));
+        b = f >= 0 ? k * n + static_cast<int>(f) : b;
+        count += hn::CountTrue(d16, hn::Eq(hn::Min(sk, vt), sk));  // sum <= thresh
+      }
+      const int cm = c[b > 0 ? b - 1 : 0], cp = c[b < nd - 1 ? b + 1 : nd - 1];
+      const size_t near = 1 + static_cast<size_t>(b > 0 && cm <= thresh) +
+                          static_cast<size_t>(b < nd - 1 && cp <= thresh);
+      unique = count == near;
     }
     const int cm = c[b > 0 ? b - 1 : 0], cp = c[b < nd - 1 ? b + 1 : nd - 1];
-    const size_t near = 1 + static_cast<size_t>(b > 0 && cm <= thresh) +
-                        static_cast<size_t>(b < nd - 1 && cp <= thresh);
-    const bool ok = tex[x0 + i] != 0 && (u <= 0 || count == near);
+    const bool ok = tex[i] != 0 && (u <= 0 || unique);
     const int d16v = (b > 0 && b < nd - 1) ? subpixel_disparity16(b, cm, m, cp) : b * 16;
-    out[x0 + i] = ok ? static_cast<std::int16_t>(d16v + min16) : kInvalid16;
+    out[i] = ok ? static_cast<std::int16_t>(d16v + min16) : kInvalid16;
     best[i] = b;
     // The oldest column leaves the window.
-    const std::uint16_t* old = v + static_cast<size_t>(i) * nd;
+    const std::uint16_t* HWY_RESTRICT old = v + static_cast<size_t>(i) * nd;
     for (int k = 0; k < nv; ++k) {
       if constexpr (kNV > 0) {
         sr[k] = hn::Sub(sr[k], hn::Load(d16, old + k * n));
@@ -205,17 +288,17 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
 template <bool kCensus, int kNV, class D16>
 void MatchRowsT(D16 d16, const FastJob& j) {
   const int nd = j.num_disp, h = j.half;
-  const int xb = j.min_disp + nd - 1;  // first column with a full search range
+  const int xb = j.min_disp + nd - 1;       // first column with a full search range
   const int x0 = xb + h, x1 = j.width - h;  // output columns
   const int ncols = j.width - xb, nout = x1 - x0;
-  const size_t step = kCensus ? j.step16 : j.step8;
   std::uint16_t* HWY_RESTRICT v = j.v;
   std::vector<int> best(nout);
   std::fill(v, v + static_cast<size_t>(ncols) * nd, std::uint16_t{0});
-  for (int row = 0; row < 2 * h + 1; ++row)
+  for (int row = 0; row < 2 * h + 1; ++row) {
+    const RowPtrs ra = RowAt(j, row);
     for (int c = 0; c < ncols; ++c)
-      UpdateColumn<kCensus, false>(d16, j, static_cast<size_t>(row) * step, 0, xb + c,
-                                   v + static_cast<size_t>(c) * nd);
+      UpdateColumn<kCensus, false, kNV>(d16, ra, ra, xb + c, nd, v + static_cast<size_t>(c) * nd);
+  }
 
   for (int y = j.y_begin; y < j.y_end; ++y) {
     if (y > j.y_begin)
