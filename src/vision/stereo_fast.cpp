@@ -365,6 +365,84 @@ void MatchRows(const FastJob& j) {
   }
 }
 
+/// StereoBM's x-Sobel prefilter of one row (as fast_detail::prefilter_rows, which is the
+/// reference): rows a, b, c are the rows above, at and below; out[0] = out[width - 1] = cap.
+/// When `reverse`, the row is written reversed (out[width - 1 - x]).
+void PrefilterRow(const std::uint8_t* HWY_RESTRICT a, const std::uint8_t* HWY_RESTRICT b,
+                  const std::uint8_t* HWY_RESTRICT c, int width, int cap, bool reverse,
+                  std::uint8_t* HWY_RESTRICT out) {
+  const hn::ScalableTag<std::int16_t> di;
+  const hn::Rebind<std::uint8_t, decltype(di)> d8;
+  const int n = static_cast<int>(hn::Lanes(di));
+  const auto vcap = hn::Set(di, static_cast<std::int16_t>(cap));
+  const auto vneg = hn::Set(di, static_cast<std::int16_t>(-cap));
+  const auto load = [&](const std::uint8_t* p) { return hn::PromoteTo(di, hn::LoadU(d8, p)); };
+  const auto at = [&](int x) { return reverse ? width - 1 - x : x; };
+  out[0] = static_cast<std::uint8_t>(cap);
+  out[width - 1] = static_cast<std::uint8_t>(cap);
+  int x = 1;
+  for (; x + n <= width - 1; x += n) {
+    const auto ga = hn::Sub(load(a + x + 1), load(a + x - 1));
+    const auto gb = hn::Sub(load(b + x + 1), load(b + x - 1));
+    const auto gc = hn::Sub(load(c + x + 1), load(c + x - 1));
+    const auto g = hn::Add(hn::Add(ga, gc), hn::Add(gb, gb));
+    auto v = hn::Add(hn::Min(hn::Max(g, vneg), vcap), vcap);
+    if (reverse) {
+      v = hn::Reverse(di, v);
+      hn::StoreU(hn::DemoteTo(d8, v), d8, out + (width - x - n));
+    } else {
+      hn::StoreU(hn::DemoteTo(d8, v), d8, out + x);
+    }
+  }
+  for (; x + 1 < width; ++x) {
+    const int g = (a[x + 1] - a[x - 1]) + 2 * (b[x + 1] - b[x - 1]) + (c[x + 1] - c[x - 1]);
+    out[at(x)] = static_cast<std::uint8_t>(std::clamp(g, -cap, cap) + cap);
+  }
+}
+
+/// Texture column sums: sums[x] += |add[x] - cap| and, when `sub`, -= |sub[x] - cap| (u16, exact
+/// modulo 2^16; the true sums fit).
+void TextureColumns(const std::uint8_t* HWY_RESTRICT add, const std::uint8_t* HWY_RESTRICT sub,
+                    int width, int cap, std::uint16_t* HWY_RESTRICT sums) {
+  const hn::ScalableTag<std::uint16_t> d16;
+  const hn::Rebind<std::uint8_t, decltype(d16)> d8;
+  const int n = static_cast<int>(hn::Lanes(d16));
+  const auto vcap = hn::Set(d16, static_cast<std::uint16_t>(cap));
+  const auto absdiff = [&](const std::uint8_t* p) {
+    const auto v = hn::PromoteTo(d16, hn::LoadU(d8, p));
+    return hn::Sub(hn::Max(v, vcap), hn::Min(v, vcap));
+  };
+  int x = 0;
+  for (; x + n <= width; x += n) {
+    auto s = hn::Add(hn::LoadU(d16, sums + x), absdiff(add + x));
+    if (sub != nullptr) s = hn::Sub(s, absdiff(sub + x));
+    hn::StoreU(s, d16, sums + x);
+  }
+  for (; x < width; ++x) {
+    int s = sums[x] + std::abs(add[x] - cap);
+    if (sub != nullptr) s -= std::abs(sub[x] - cap);
+    sums[x] = static_cast<std::uint16_t>(s);
+  }
+}
+
+/// 1/16 px disparities (kInvalid16 = invalid) to px floats (invalid = -1), as store_disparity16.
+void StoreRow(const std::int16_t* HWY_RESTRICT src, int width, float* HWY_RESTRICT dst) {
+  const hn::ScalableTag<float> df;
+  const hn::Rebind<std::int32_t, decltype(df)> di32;
+  const hn::Rebind<std::int16_t, decltype(df)> di16;
+  const int n = static_cast<int>(hn::Lanes(df));
+  const auto inv = hn::Set(di32, static_cast<std::int32_t>(kInvalid16));
+  const auto scale = hn::Set(df, 1.0f / 16.0f);  // exact: a power of two
+  const auto minus1 = hn::Set(df, -1.0f);
+  int x = 0;
+  for (; x + n <= width; x += n) {
+    const auto v = hn::PromoteTo(di32, hn::LoadU(di16, src + x));
+    const auto f = hn::Mul(hn::ConvertTo(df, v), scale);
+    hn::StoreU(hn::IfThenElse(hn::RebindMask(df, hn::Eq(v, inv)), minus1, f), df, dst + x);
+  }
+  for (; x < width; ++x) dst[x] = src[x] == kInvalid16 ? -1.0f : static_cast<float>(src[x]) / 16.0f;
+}
+
 std::int64_t CurrentTarget() { return HWY_TARGET; }
 
 }  // namespace HWY_NAMESPACE
@@ -376,6 +454,9 @@ namespace sg::vision {
 namespace fast_detail {
 HWY_EXPORT(MatchRows);
 HWY_EXPORT(CurrentTarget);
+HWY_EXPORT(PrefilterRow);
+HWY_EXPORT(TextureColumns);
+HWY_EXPORT(StoreRow);
 
 namespace {
 /// Copies each row of `rows` (elements of type T) through `f` into the continuous buffer `out`,
@@ -394,8 +475,9 @@ void plane(const cv::Mat& rows, bool reverse, F f, std::vector<Out>& out) {
 /// Buffers reused across calls on one thread: allocating megabytes per frame costs page faults.
 /// They hold no state that reaches the output.
 struct Scratch {
-  cv::Mat pl, pr, cl, cr, integral, tex_ok, out16;
+  cv::Mat pl, cl, cr, tex_ok, out16;
   std::vector<std::uint8_t> r8;
+  std::vector<std::uint16_t> tex_cols;
   std::vector<std::uint16_t> llo, lhi, rlo, rhi;
   hwy::AlignedFreeUniquePtr<std::uint16_t[]> v, s, small;
   size_t v_size = 0, s_size = 0, small_size = 0;
@@ -441,12 +523,24 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
 
   thread_local Scratch scratch;
   Scratch& sc = scratch;
-  cv::Mat &pl = sc.pl, &pr = sc.pr, &cl = sc.cl, &cr = sc.cr;
-  prefilter_rows(left, p.prefilter_cap, ya, yb, pl);  // SAD cost and texture
+  cv::Mat &pl = sc.pl, &cl = sc.cl, &cr = sc.cr;
+  // Prefiltered rows (SAD cost and texture), right rows reversed; SIMD, equal to prefilter_rows.
+  const auto reflect = [height](int y) {
+    if (height == 1) return 0;
+    return y < 0 ? -y : (y >= height ? 2 * height - 2 - y : y);
+  };
+  const auto prefilter = [&](const cv::Mat& img, bool reverse, std::uint8_t* dst) {
+    for (int y = ya; y < yb; ++y)
+      HWY_DYNAMIC_DISPATCH(PrefilterRow)
+      (img.ptr<std::uint8_t>(reflect(y - 1)), img.ptr<std::uint8_t>(y),
+       img.ptr<std::uint8_t>(reflect(y + 1)), width, p.prefilter_cap, reverse,
+       dst + static_cast<size_t>(y - ya) * width);
+  };
+  pl.create(yb - ya, width, CV_8U);
+  prefilter(left, false, pl.ptr<std::uint8_t>(0));
   if (!job.census) {
-    prefilter_rows(right, p.prefilter_cap, ya, yb, pr);
-    const auto same = [](std::uint8_t v) { return v; };
-    plane<std::uint8_t, std::uint8_t>(pr, true, same, sc.r8);
+    sc.r8.resize(static_cast<size_t>(yb - ya) * width);
+    prefilter(right, true, sc.r8.data());
     job.step8 = static_cast<size_t>(width);  // pl is continuous: created above
     job.left8 = pl.ptr<std::uint8_t>(0);
     job.right8_rev = sc.r8.data();
@@ -466,32 +560,29 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
     job.right_hi_rev = sc.rhi.data();
   }
 
-  // Texture: block sums of |prefiltered - cap| from an integral image (exact integers).
-  cv::Mat& integral = sc.integral;
-  integral.create(pl.rows + 1, width + 1, CV_32S);
-  integral.row(0).setTo(0);
-  for (int y = 0; y < pl.rows; ++y) {
-    const std::uint8_t* src = pl.ptr<std::uint8_t>(y);
-    const int* above = integral.ptr<int>(y);
-    int* dst = integral.ptr<int>(y + 1);
-    dst[0] = 0;
-    int row_sum = 0;
-    for (int x = 0; x < width; ++x) {
-      row_sum += std::abs(src[x] - p.prefilter_cap);
-      dst[x + 1] = above[x + 1] + row_sum;
-    }
-  }
+  // Texture: block sums of |prefiltered - cap|, column sums moved down row by row, then a running
+  // sum along the row (exact integers).
   cv::Mat& tex_ok = sc.tex_ok;
   tex_ok.create(y1 - y0, width, CV_8U);
   tex_ok.setTo(0);
   const int b = 2 * h + 1;
+  sc.tex_cols.assign(width, 0);
+  std::uint16_t* cols = sc.tex_cols.data();
+  for (int r = 0; r < b; ++r)
+    HWY_DYNAMIC_DISPATCH(TextureColumns)(pl.ptr<std::uint8_t>(r), nullptr, width, p.prefilter_cap,
+                                         cols);
   for (int y = y0; y < y1; ++y) {
-    const int* top = integral.ptr<int>(y - h - ya);
-    const int* bottom = integral.ptr<int>(y - h - ya + b);
+    if (y > y0)
+      HWY_DYNAMIC_DISPATCH(TextureColumns)
+      (pl.ptr<std::uint8_t>(y + h - ya), pl.ptr<std::uint8_t>(y - h - 1 - ya), width,
+       p.prefilter_cap, cols);
     std::uint8_t* ok = tex_ok.ptr<std::uint8_t>(y - y0);
+    int sum = 0;
+    for (int x = 0; x < 2 * h; ++x) sum += cols[x];
     for (int x = h; x < width - h; ++x) {
-      const int sum = bottom[x + h + 1] - bottom[x - h] - top[x + h + 1] + top[x - h];
+      sum += cols[x + h];
       ok[x] = sum >= p.texture_threshold ? 1 : 0;
+      sum -= cols[x - h];
     }
   }
   job.texture_ok = tex_ok.ptr<std::uint8_t>(0);
@@ -509,7 +600,8 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
   job.out = out16.ptr<std::int16_t>(0);
   job.out_step = out16.step1();
   HWY_DYNAMIC_DISPATCH(MatchRows)(job);
-  store_disparity16(out16, y0, disp);
+  for (int y = y0; y < y1; ++y)
+    HWY_DYNAMIC_DISPATCH(StoreRow)(out16.ptr<std::int16_t>(y - y0), width, disp.ptr<float>(y));
 }
 
 }  // namespace sg::vision
