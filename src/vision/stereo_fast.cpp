@@ -123,6 +123,28 @@ HWY_INLINE void UpdateColumn(D16 d16, const RowPtrs& a, const RowPtrs& s, int x,
     }
   }
   const int end = kNV > 0 ? kNV * n : nd;
+#if HWY_TARGET != HWY_SCALAR
+  if constexpr (!kCensus && kSub && kNV > 0 && kNV % 2 == 0 && hn::MaxLanes(d16) >= 8) {
+    // Two vectors at once from full-width u8 vectors: |l - r| of both rows in u8, their
+    // difference in i8 (both are at most 2 * 63), widened and added.
+    const hn::Repartition<std::uint8_t, D16> d8;
+    const hn::Repartition<std::int8_t, D16> di8;
+    const hn::Half<decltype(di8)> dh8;
+    const hn::Repartition<std::int16_t, D16> di16;
+    const auto l8a = hn::Set(d8, a.l8[x]), l8s = hn::Set(d8, s.l8[x]);
+    for (int d = 0; d < end; d += 2 * n) {
+      const auto ra8 = hn::LoadU(d8, a.r8 - x + d), rs8 = hn::LoadU(d8, s.r8 - x + d);
+      const auto da = hn::Sub(hn::Max(l8a, ra8), hn::Min(l8a, ra8));
+      const auto ds = hn::Sub(hn::Max(l8s, rs8), hn::Min(l8s, rs8));
+      const auto delta = hn::BitCast(di8, hn::Sub(da, ds));
+      const auto lo = hn::BitCast(d16, hn::PromoteTo(di16, hn::LowerHalf(dh8, delta)));
+      const auto hi = hn::BitCast(d16, hn::PromoteTo(di16, hn::UpperHalf(dh8, delta)));
+      hn::Store(hn::Add(hn::Load(d16, col + d), lo), d16, col + d);
+      hn::Store(hn::Add(hn::Load(d16, col + d + n), hi), d16, col + d + n);
+    }
+    return;
+  }
+#endif
   for (int d = 0; d < end; d += n) {
     auto acc = hn::Add(hn::Load(d16, col + d), CostAt<kCensus>(d16, a, la, ha, x, d));
     if constexpr (kSub) acc = hn::Sub(acc, CostAt<kCensus>(d16, s, ls, hs, x, d));
@@ -250,8 +272,12 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
       for (int w = kWords - 1; w >= 0; --w)
         b = eq[w] != 0 ? w * 64 + static_cast<int>(hwy::Num0BitsBelowLS1Bit_Nonzero64(eq[w])) : b;
       std::uint64_t far = 0;
-      for (int w = 0; w < kWords; ++w)
-        far |= le[w] & ~(BitIn(w, b - 1) | BitIn(w, b) | BitIn(w, b + 1));
+      if constexpr (kWords == 1) {
+        far = le[0] & ~(b > 0 ? std::uint64_t{7} << (b - 1) : std::uint64_t{3});
+      } else {
+        for (int w = 0; w < kWords; ++w)
+          far |= le[w] & ~(BitIn(w, b - 1) | BitIn(w, b) | BitIn(w, b + 1));
+      }
       unique = far == 0;
     } else {
       size_t count = 0;
