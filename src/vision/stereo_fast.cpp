@@ -42,11 +42,11 @@ struct FastJob {
   size_t step16 = 0;
   const std::uint8_t* texture_ok = nullptr;  ///< per output row and x: 1 = enough texture
   size_t texture_step = 0;
-  std::uint16_t* v = nullptr;   ///< scratch: column sums, (width - xb) x num_disp, aligned
-  std::uint16_t* s = nullptr;   ///< scratch: block sums of one row, output columns x num_disp
+  std::uint16_t* v = nullptr;     ///< scratch: column sums, (width - xb) x num_disp, aligned
+  std::uint16_t* s = nullptr;     ///< scratch: block sums of one row, output columns x num_disp
   std::uint16_t* sacc = nullptr;  ///< scratch: running horizontal sums, num_disp, aligned
   std::uint16_t* cbuf = nullptr;  ///< scratch: one pixel's block sums, num_disp, aligned
-  std::int16_t* out = nullptr;  ///< per output row: disparity * 16 or kInvalid16
+  std::int16_t* out = nullptr;    ///< per output row: disparity * 16 or kInvalid16
   size_t out_step = 0;
 };
 }  // namespace sg::vision::fast_detail
@@ -85,8 +85,8 @@ HWY_INLINE RowPtrs RowAt(const FastJob& j, int row) {
 /// Pixel costs of left pixel x at the disparities [d, d + Lanes(d16)) of one row: |left - right|
 /// of the prefiltered images or census Hamming distances. `lv`, `lhi`: left pixel broadcast.
 template <bool kCensus, class D16>
-HWY_INLINE hn::Vec<D16> CostAt(D16 d16, const RowPtrs& p, hn::Vec<D16> lv, hn::Vec<D16> lhi,
-                               int x, int d) {
+HWY_INLINE hn::Vec<D16> CostAt(D16 d16, const RowPtrs& p, hn::Vec<D16> lv, hn::Vec<D16> lhi, int x,
+                               int d) {
   if constexpr (!kCensus) {
     const hn::Rebind<std::uint8_t, D16> d8;
     const auto rv = hn::PromoteTo(d16, hn::LoadU(d8, p.r8 - x + d));
@@ -253,7 +253,8 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
       hn::Store(sk, d16, c + k * n);
       vmin = hn::Min(vmin, sk);
     }
-    // Winner: the first disparity with the smallest sum. Uniqueness: no disparity further than
+    // Winner: the largest disparity with the smallest sum (StereoBM's choice on ties; the nearer
+    // surface, the cautious one for obstacle warning). Uniqueness: no disparity further than
     // 1 px from it at or below the threshold. Branch-free: where the winner is is unpredictable.
     const int m = MinLane(d16, vmin);
     const auto vm = hn::Set(d16, static_cast<std::uint16_t>(m));
@@ -269,8 +270,9 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
         eq[w] |= MaskBits(d16, hn::Eq(sr[k], vm)) << sh;
         le[w] |= MaskBits(d16, hn::Eq(hn::Min(sr[k], vt), sr[k])) << sh;  // sum <= thresh
       }
-      for (int w = kWords - 1; w >= 0; --w)
-        b = eq[w] != 0 ? w * 64 + static_cast<int>(hwy::Num0BitsBelowLS1Bit_Nonzero64(eq[w])) : b;
+      for (int w = 0; w < kWords; ++w)  // the last (largest) disparity with the minimum
+        b = eq[w] != 0 ? w * 64 + 63 - static_cast<int>(hwy::Num0BitsAboveMS1Bit_Nonzero64(eq[w]))
+                       : b;
       std::uint64_t far = 0;
       if constexpr (kWords == 1) {
         far = le[0] & ~(b > 0 ? std::uint64_t{7} << (b - 1) : std::uint64_t{3});
@@ -281,10 +283,10 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
       unique = far == 0;
     } else {
       size_t count = 0;
-      for (int k = nv - 1; k >= 0; --k) {
+      for (int k = 0; k < nv; ++k) {
         const auto sk = hn::Load(d16, c + k * n);
-        const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(sk, vm));
-        b = f >= 0 ? k * n + static_cast<int>(f) : b;
+        const std::uint64_t bits = MaskBits(d16, hn::Eq(sk, vm));
+        b = bits != 0 ? k * n + 63 - static_cast<int>(hwy::Num0BitsAboveMS1Bit_Nonzero64(bits)) : b;
         count += hn::CountTrue(d16, hn::Eq(hn::Min(sk, vt), sk));  // sum <= thresh
       }
       const int cm = c[b > 0 ? b - 1 : 0], cp = c[b < nd - 1 ? b + 1 : nd - 1];
@@ -557,10 +559,15 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
   };
   const auto prefilter = [&](const cv::Mat& img, bool reverse, std::uint8_t* dst) {
     for (int y = ya; y < yb; ++y)
-      HWY_DYNAMIC_DISPATCH(PrefilterRow)
-      (img.ptr<std::uint8_t>(reflect(y - 1)), img.ptr<std::uint8_t>(y),
-       img.ptr<std::uint8_t>(reflect(y + 1)), width, p.prefilter_cap, reverse,
-       dst + static_cast<size_t>(y - ya) * width);
+      if (height % 2 == 1 && y == height - 1 && height > 1)  // flat, as StereoBM
+        std::fill(dst + static_cast<size_t>(y - ya) * width,
+                  dst + static_cast<size_t>(y - ya + 1) * width,
+                  static_cast<std::uint8_t>(p.prefilter_cap));
+      else
+        HWY_DYNAMIC_DISPATCH(PrefilterRow)
+    (img.ptr<std::uint8_t>(reflect(y - 1)), img.ptr<std::uint8_t>(y),
+     img.ptr<std::uint8_t>(reflect(y + 1)), width, p.prefilter_cap, reverse,
+     dst + static_cast<size_t>(y - ya) * width);
   };
   pl.create(yb - ya, width, CV_8U);
   prefilter(left, false, pl.ptr<std::uint8_t>(0));
@@ -595,13 +602,12 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
   sc.tex_cols.assign(width, 0);
   std::uint16_t* cols = sc.tex_cols.data();
   for (int r = 0; r < b; ++r)
-    HWY_DYNAMIC_DISPATCH(TextureColumns)(pl.ptr<std::uint8_t>(r), nullptr, width, p.prefilter_cap,
-                                         cols);
+    HWY_DYNAMIC_DISPATCH(TextureColumns)
+    (pl.ptr<std::uint8_t>(r), nullptr, width, p.prefilter_cap, cols);
   for (int y = y0; y < y1; ++y) {
-    if (y > y0)
-      HWY_DYNAMIC_DISPATCH(TextureColumns)
-      (pl.ptr<std::uint8_t>(y + h - ya), pl.ptr<std::uint8_t>(y - h - 1 - ya), width,
-       p.prefilter_cap, cols);
+    if (y > y0) HWY_DYNAMIC_DISPATCH(TextureColumns)
+    (pl.ptr<std::uint8_t>(y + h - ya), pl.ptr<std::uint8_t>(y - h - 1 - ya), width, p.prefilter_cap,
+     cols);
     std::uint8_t* ok = tex_ok.ptr<std::uint8_t>(y - y0);
     int sum = 0;
     for (int x = 0; x < 2 * h; ++x) sum += cols[x];
