@@ -42,11 +42,12 @@ struct FastJob {
   size_t step16 = 0;
   const std::uint8_t* texture_ok = nullptr;  ///< per output row and x: 1 = enough texture
   size_t texture_step = 0;
-  std::uint16_t* v = nullptr;     ///< scratch: column sums, (width - xb) x num_disp, aligned
-  std::uint16_t* s = nullptr;     ///< scratch: block sums of one row, output columns x num_disp
-  std::uint16_t* sacc = nullptr;  ///< scratch: running horizontal sums, num_disp, aligned
-  std::uint16_t* cbuf = nullptr;  ///< scratch: one pixel's block sums, num_disp, aligned
-  std::int16_t* out = nullptr;    ///< per output row: disparity * 16 or kInvalid16
+  std::uint16_t* v = nullptr;        ///< scratch: column sums, (width - xb) x num_disp, aligned
+  std::uint16_t* s = nullptr;        ///< scratch: block sums of one row, output columns x num_disp
+  std::uint16_t* sacc = nullptr;     ///< scratch: running horizontal sums, num_disp, aligned
+  std::uint16_t* mins = nullptr;     ///< scratch: per output column of a row, smallest sum
+  std::uint16_t* threshs = nullptr;  ///< scratch: per output column of a row, uniqueness bound
+  std::int16_t* out = nullptr;       ///< per output row: disparity * 16 or kInvalid16
   size_t out_step = 0;
 };
 }  // namespace sg::vision::fast_detail
@@ -211,7 +212,6 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
   const RowPtrs ra = RowAt(j, row + h), rs = RowAt(j, kSub ? row - h - 1 : 0);
   std::uint16_t* HWY_RESTRICT v = j.v;
   std::uint16_t* HWY_RESTRICT sacc = j.sacc;  // S when kNV == 0, nd lanes
-  const bool keep = j.lr_max_diff >= 0;       // all block sums of the row kept for the LR check
   const int u = j.uniqueness;
 
   hn::Vec<D16> sr[kMaxNV];  // S when kNV > 0
@@ -234,13 +234,14 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
   const std::uint8_t* HWY_RESTRICT tex =
       j.texture_ok + static_cast<size_t>(y - j.y_begin) * j.texture_step + x0;
   std::uint16_t* HWY_RESTRICT s = j.s;
-  std::uint16_t* HWY_RESTRICT cbuf = j.cbuf;
-  const int min16 = j.min_disp * 16;
+  std::uint16_t* HWY_RESTRICT mins = j.mins;
+  std::uint16_t* HWY_RESTRICT threshs = j.threshs;
+  // Pass 1: block sums of every pixel of the row (kept in s) and their minimum. Nothing here
+  // waits on a reduction, so consecutive pixels overlap in the core.
   for (int i = 0; i < nout; ++i) {
     std::uint16_t* HWY_RESTRICT col = v + static_cast<size_t>(i + 2 * h) * nd;
     if constexpr (kSub) UpdateColumn<kCensus, true, kNV>(d16, ra, rs, xb + i + 2 * h, nd, col);
-    // c: this pixel's block sums in memory, for the scalar look-ups below.
-    std::uint16_t* HWY_RESTRICT c = keep ? s + static_cast<size_t>(i) * nd : cbuf;
+    std::uint16_t* HWY_RESTRICT c = s + static_cast<size_t>(i) * nd;
     auto vmin = hn::Set(d16, std::uint16_t{0xFFFF});
     for (int k = 0; k < nv; ++k) {
       hn::Vec<D16> sk;
@@ -253,13 +254,33 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
       hn::Store(sk, d16, c + k * n);
       vmin = hn::Min(vmin, sk);
     }
-    // Winner: the largest disparity with the smallest sum (StereoBM's choice on ties; the nearer
-    // surface, the cautious one for obstacle warning). Uniqueness: no disparity further than
-    // 1 px from it at or below the threshold. Branch-free: where the winner is is unpredictable.
-    const int m = MinLane(d16, vmin);
-    const auto vm = hn::Set(d16, static_cast<std::uint16_t>(m));
-    const int thresh = u > 0 ? std::min(m + m * u / 100, 65535) : 0;
-    const auto vt = hn::Set(d16, static_cast<std::uint16_t>(thresh));
+    mins[i] = MinLane(d16, vmin);
+    // The oldest column leaves the window.
+    const std::uint16_t* HWY_RESTRICT old = v + static_cast<size_t>(i) * nd;
+    for (int k = 0; k < nv; ++k) {
+      if constexpr (kNV > 0) {
+        sr[k] = hn::Sub(sr[k], hn::Load(d16, old + k * n));
+      } else {
+        hn::Store(hn::Sub(hn::Add(hn::Load(d16, sacc + k * n), hn::Load(d16, col + k * n)),
+                          hn::Load(d16, old + k * n)),
+                  d16, sacc + k * n);
+      }
+    }
+  }
+  // Uniqueness thresholds of the row (a loop the compiler vectorises).
+  for (int i = 0; i < nout; ++i) {
+    const int m = mins[i];
+    threshs[i] = static_cast<std::uint16_t>(u > 0 ? std::min(m + m * u / 100, 65535) : 0);
+  }
+  // Pass 2: winner: the largest disparity with the smallest sum (StereoBM's choice on ties; the
+  // nearer surface, the cautious one for obstacle warning). Uniqueness: no disparity further than
+  // 1 px from it at or below the threshold. Branch-free: where the winner is is unpredictable.
+  const int min16 = j.min_disp * 16;
+  for (int i = 0; i < nout; ++i) {
+    const std::uint16_t* HWY_RESTRICT c = s + static_cast<size_t>(i) * nd;
+    const int m = mins[i], thresh = threshs[i];
+    const auto vm = hn::Set(d16, mins[i]);
+    const auto vt = hn::Set(d16, threshs[i]);
     int b = 0;
     bool unique = true;
     if constexpr (kNV > 0) {
@@ -267,8 +288,9 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
       std::uint64_t eq[kWords] = {}, le[kWords] = {};
       for (int k = 0; k < kNV; ++k) {
         const int w = k * n / 64, sh = k * n % 64;
-        eq[w] |= MaskBits(d16, hn::Eq(sr[k], vm)) << sh;
-        le[w] |= MaskBits(d16, hn::Eq(hn::Min(sr[k], vt), sr[k])) << sh;  // sum <= thresh
+        const auto sk = hn::Load(d16, c + k * n);
+        eq[w] |= MaskBits(d16, hn::Eq(sk, vm)) << sh;
+        le[w] |= MaskBits(d16, hn::Eq(hn::Min(sk, vt), sk)) << sh;  // sum <= thresh
       }
       for (int w = 0; w < kWords; ++w)  // the last (largest) disparity with the minimum
         b = eq[w] != 0 ? w * 64 + 63 - static_cast<int>(hwy::Num0BitsAboveMS1Bit_Nonzero64(eq[w]))
@@ -299,17 +321,6 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
     const int d16v = (b > 0 && b < nd - 1) ? subpixel_disparity16(b, cm, m, cp) : b * 16;
     out[i] = ok ? static_cast<std::int16_t>(d16v + min16) : kInvalid16;
     best[i] = b;
-    // The oldest column leaves the window.
-    const std::uint16_t* HWY_RESTRICT old = v + static_cast<size_t>(i) * nd;
-    for (int k = 0; k < nv; ++k) {
-      if constexpr (kNV > 0) {
-        sr[k] = hn::Sub(sr[k], hn::Load(d16, old + k * n));
-      } else {
-        hn::Store(hn::Sub(hn::Add(hn::Load(d16, sacc + k * n), hn::Load(d16, col + k * n)),
-                          hn::Load(d16, old + k * n)),
-                  d16, sacc + k * n);
-      }
-    }
   }
 }
 
@@ -601,9 +612,8 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
   const int b = 2 * h + 1;
   sc.tex_cols.assign(width, 0);
   std::uint16_t* cols = sc.tex_cols.data();
-  for (int r = 0; r < b; ++r)
-    HWY_DYNAMIC_DISPATCH(TextureColumns)
-    (pl.ptr<std::uint8_t>(r), nullptr, width, p.prefilter_cap, cols);
+  for (int r = 0; r < b; ++r) HWY_DYNAMIC_DISPATCH(TextureColumns)
+  (pl.ptr<std::uint8_t>(r), nullptr, width, p.prefilter_cap, cols);
   for (int y = y0; y < y1; ++y) {
     if (y > y0) HWY_DYNAMIC_DISPATCH(TextureColumns)
     (pl.ptr<std::uint8_t>(y + h - ya), pl.ptr<std::uint8_t>(y - h - 1 - ya), width, p.prefilter_cap,
@@ -625,10 +635,11 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
   out16.setTo(kInvalid16);
   const int xb = md + nd - 1;
   job.v = aligned(sc.v, sc.v_size, static_cast<size_t>(width - xb) * nd);
-  if (job.lr_max_diff >= 0)
-    job.s = aligned(sc.s, sc.s_size, static_cast<size_t>(width - h - (xb + h)) * nd);
-  job.sacc = aligned(sc.small, sc.small_size, 2 * static_cast<size_t>(nd));
-  job.cbuf = job.sacc + nd;
+  const size_t nout = static_cast<size_t>(width - h - (xb + h));
+  job.s = aligned(sc.s, sc.s_size, nout * nd);
+  job.sacc = aligned(sc.small, sc.small_size, static_cast<size_t>(nd) + 2 * nout + 64);
+  job.mins = job.sacc + nd;
+  job.threshs = job.mins + nout;
   job.out = out16.ptr<std::int16_t>(0);
   job.out_step = out16.step1();
   HWY_DYNAMIC_DISPATCH(MatchRows)(job);
