@@ -439,6 +439,56 @@ void PrefilterRow(const std::uint8_t* HWY_RESTRICT a, const std::uint8_t* HWY_RE
   }
 }
 
+/// 5x5 census signatures of one row (as fast_detail::census_rows, which is the reference), split
+/// into their low 16 and high 8 bits. `pad`: the 5 rows y - 2 .. y + 2 with the border replicated,
+/// each width + 4 long, pixel x at index x + 2. When `reverse`, the row is written reversed.
+void CensusRow(const std::uint8_t* HWY_RESTRICT pad, int width, bool reverse,
+               std::uint16_t* HWY_RESTRICT lo, std::uint16_t* HWY_RESTRICT hi) {
+  const hn::ScalableTag<std::uint16_t> d16;
+  const hn::Rebind<std::int16_t, decltype(d16)> di;  // pixels compared as signed 16-bit
+  const hn::Rebind<std::uint8_t, decltype(d16)> d8;
+  const int n = static_cast<int>(hn::Lanes(d16));
+  const int r = kCensusRadius, pw = width + 2 * r;
+  const auto one = hn::Set(d16, std::uint16_t{1});
+  int x = 0;
+  for (; x + n <= width; x += n) {
+    const auto centre = hn::PromoteTo(di, hn::LoadU(d8, pad + r * pw + r + x));
+    auto vlo = hn::Zero(d16), vhi = hn::Zero(d16);
+    int k = 0;
+    for (int dy = -r; dy <= r; ++dy) {
+      for (int dx = -r; dx <= r; ++dx) {
+        if (dy == 0 && dx == 0) continue;
+        const auto nb = hn::PromoteTo(di, hn::LoadU(d8, pad + (dy + r) * pw + r + dx + x));
+        const auto bit =
+            hn::And(hn::VecFromMask(d16, hn::RebindMask(d16, hn::Lt(nb, centre))), one);
+        if (k < 8)
+          vhi = hn::Or(hn::Add(vhi, vhi), bit);
+        else
+          vlo = hn::Or(hn::Add(vlo, vlo), bit);
+        ++k;
+      }
+    }
+    if (reverse) {
+      hn::StoreU(hn::Reverse(d16, vlo), d16, lo + (width - x - n));
+      hn::StoreU(hn::Reverse(d16, vhi), d16, hi + (width - x - n));
+    } else {
+      hn::StoreU(vlo, d16, lo + x);
+      hn::StoreU(vhi, d16, hi + x);
+    }
+  }
+  for (; x < width; ++x) {
+    const int c = pad[r * pw + r + x];
+    std::uint32_t code = 0;
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx)
+        if (dy != 0 || dx != 0)
+          code = (code << 1) | static_cast<std::uint32_t>(pad[(dy + r) * pw + r + dx + x] < c);
+    const int at = reverse ? width - 1 - x : x;
+    lo[at] = static_cast<std::uint16_t>(code & 0xFFFF);
+    hi[at] = static_cast<std::uint16_t>(code >> 16);
+  }
+}
+
 /// Texture column sums: sums[x] += |add[x] - cap| and, when `sub`, -= |sub[x] - cap| (u16, exact
 /// modulo 2^16; the true sums fit).
 void TextureColumns(const std::uint8_t* HWY_RESTRICT add, const std::uint8_t* HWY_RESTRICT sub,
@@ -494,28 +544,16 @@ namespace fast_detail {
 HWY_EXPORT(MatchRows);
 HWY_EXPORT(CurrentTarget);
 HWY_EXPORT(PrefilterRow);
+HWY_EXPORT(CensusRow);
 HWY_EXPORT(TextureColumns);
 HWY_EXPORT(StoreRow);
 
 namespace {
-/// Copies each row of `rows` (elements of type T) through `f` into the continuous buffer `out`,
-/// reversed when `reverse`.
-template <typename Out, typename T, typename F>
-void plane(const cv::Mat& rows, bool reverse, F f, std::vector<Out>& out) {
-  const int w = rows.cols;
-  out.resize(static_cast<size_t>(rows.rows) * w);
-  for (int y = 0; y < rows.rows; ++y) {
-    const T* src = rows.ptr<T>(y);
-    Out* dst = out.data() + static_cast<size_t>(y) * w;
-    for (int x = 0; x < w; ++x) dst[reverse ? w - 1 - x : x] = f(src[x]);
-  }
-}
-
 /// Buffers reused across calls on one thread: allocating megabytes per frame costs page faults.
 /// They hold no state that reaches the output.
 struct Scratch {
-  cv::Mat pl, cl, cr, tex_ok, out16;
-  std::vector<std::uint8_t> r8;
+  cv::Mat pl, tex_ok, out16;
+  std::vector<std::uint8_t> r8, pad;
   std::vector<std::uint16_t> tex_cols;
   std::vector<std::uint16_t> llo, lhi, rlo, rhi;
   hwy::AlignedFreeUniquePtr<std::uint16_t[]> v, s, small;
@@ -562,7 +600,7 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
 
   thread_local Scratch scratch;
   Scratch& sc = scratch;
-  cv::Mat &pl = sc.pl, &cl = sc.cl, &cr = sc.cr;
+  cv::Mat& pl = sc.pl;
   // Prefiltered rows (SAD cost and texture), right rows reversed; SIMD, equal to prefilter_rows.
   const auto reflect = [height](int y) {
     if (height == 1) return 0;
@@ -589,14 +627,31 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
     job.left8 = pl.ptr<std::uint8_t>(0);
     job.right8_rev = sc.r8.data();
   } else {
-    census_rows(left, ya, yb, cl);
-    census_rows(right, ya, yb, cr);
-    const auto lo = [](int v) { return static_cast<std::uint16_t>(v & 0xFFFF); };
-    const auto hi = [](int v) { return static_cast<std::uint16_t>(v >> 16); };
-    plane<std::uint16_t, int>(cl, false, lo, sc.llo);
-    plane<std::uint16_t, int>(cl, false, hi, sc.lhi);
-    plane<std::uint16_t, int>(cr, true, lo, sc.rlo);
-    plane<std::uint16_t, int>(cr, true, hi, sc.rhi);
+    // Census planes (SIMD, equal to census_rows): rows padded with the replicated border.
+    const int r = kCensusRadius, pw = width + 2 * r;
+    std::vector<std::uint8_t>& pad = sc.pad;
+    pad.resize(static_cast<size_t>(2 * r + 1) * pw);
+    const auto census = [&](const cv::Mat& img, bool reverse, std::vector<std::uint16_t>& lo,
+                            std::vector<std::uint16_t>& hi) {
+      lo.resize(static_cast<size_t>(yb - ya) * width);
+      hi.resize(lo.size());
+      for (int y = ya; y < yb; ++y) {
+        for (int k = -r; k <= r; ++k) {
+          const std::uint8_t* src = img.ptr<std::uint8_t>(std::clamp(y + k, 0, height - 1));
+          std::uint8_t* dst = pad.data() + static_cast<size_t>(k + r) * pw;
+          std::memcpy(dst + r, src, width);
+          for (int i = 0; i < r; ++i) {
+            dst[i] = src[0];
+            dst[r + width + i] = src[width - 1];
+          }
+        }
+        const size_t off = static_cast<size_t>(y - ya) * width;
+        HWY_DYNAMIC_DISPATCH(CensusRow)
+        (pad.data(), width, reverse, lo.data() + off, hi.data() + off);
+      }
+    };
+    census(left, false, sc.llo, sc.lhi);
+    census(right, true, sc.rlo, sc.rhi);
     job.step16 = static_cast<size_t>(width);
     job.left_lo = sc.llo.data();
     job.left_hi = sc.lhi.data();
