@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <climits>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "stereo_fast_common.hpp"
@@ -41,9 +42,12 @@ struct FastJob {
   size_t step16 = 0;
   const std::uint8_t* texture_ok = nullptr;  ///< per output row and x: 1 = enough texture
   size_t texture_step = 0;
-  std::uint16_t* v = nullptr;   ///< scratch: column sums, (width - xb) x num_disp, aligned
-  std::uint16_t* s = nullptr;   ///< scratch: block sums of one row, output columns x num_disp
-  std::int16_t* out = nullptr;  ///< per output row: disparity * 16 or kInvalid16
+  std::uint16_t* v = nullptr;        ///< scratch: column sums, (width - xb) x num_disp, aligned
+  std::uint16_t* s = nullptr;        ///< scratch: block sums of one row, output columns x num_disp
+  std::uint16_t* sacc = nullptr;     ///< scratch: running horizontal sums, num_disp, aligned
+  std::uint16_t* mins = nullptr;     ///< scratch: per output column of a row, smallest sum
+  std::uint16_t* threshs = nullptr;  ///< scratch: per output column of a row, uniqueness bound
+  std::int16_t* out = nullptr;       ///< per output row: disparity * 16 or kInvalid16
   size_t out_step = 0;
 };
 }  // namespace sg::vision::fast_detail
@@ -54,40 +58,98 @@ namespace sg::vision::fast_detail {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-/// Pixel costs of input row `off` (element offset of the row) for column x and the disparities
-/// [d, d + Lanes(d16)): |left - right| of the prefiltered images or census Hamming distances.
+/// One input row's pixels as the column updates read them. The right rows are offset so that
+/// r[-x + d] is the right pixel matched with left pixel x at disparity min_disp + d.
+struct RowPtrs {
+  const std::uint8_t* l8 = nullptr;
+  const std::uint8_t* r8 = nullptr;
+  const std::uint16_t *llo = nullptr, *lhi = nullptr, *rlo = nullptr, *rhi = nullptr;
+};
+
+HWY_INLINE RowPtrs RowAt(const FastJob& j, int row) {
+  RowPtrs p;
+  const ptrdiff_t rx = j.width - 1 + j.min_disp;
+  if (j.census) {
+    const size_t off = static_cast<size_t>(row) * j.step16;
+    p.llo = j.left_lo + off;
+    p.lhi = j.left_hi + off;
+    p.rlo = j.right_lo_rev + off + rx;
+    p.rhi = j.right_hi_rev + off + rx;
+  } else {
+    const size_t off = static_cast<size_t>(row) * j.step8;
+    p.l8 = j.left8 + off;
+    p.r8 = j.right8_rev + off + rx;
+  }
+  return p;
+}
+
+/// Pixel costs of left pixel x at the disparities [d, d + Lanes(d16)) of one row: |left - right|
+/// of the prefiltered images or census Hamming distances. `lv`, `lhi`: left pixel broadcast.
 template <bool kCensus, class D16>
-HWY_INLINE hn::Vec<D16> CostAt(D16 d16, const FastJob& j, size_t off, int x, int d) {
-  const size_t rx = off + static_cast<size_t>(j.width - 1 - x + j.min_disp + d);
+HWY_INLINE hn::Vec<D16> CostAt(D16 d16, const RowPtrs& p, hn::Vec<D16> lv, hn::Vec<D16> lhi, int x,
+                               int d) {
   if constexpr (!kCensus) {
     const hn::Rebind<std::uint8_t, D16> d8;
-    const auto lv = hn::Set(d16, j.left8[off + x]);
-    const auto rv = hn::PromoteTo(d16, hn::LoadU(d8, j.right8_rev + rx));
+    const auto rv = hn::PromoteTo(d16, hn::LoadU(d8, p.r8 - x + d));
     return hn::Sub(hn::Max(lv, rv), hn::Min(lv, rv));
   } else {
-    const auto lo = hn::Xor(hn::Set(d16, j.left_lo[off + x]), hn::LoadU(d16, j.right_lo_rev + rx));
-    const auto hi = hn::Xor(hn::Set(d16, j.left_hi[off + x]), hn::LoadU(d16, j.right_hi_rev + rx));
+    const auto lo = hn::Xor(lv, hn::LoadU(d16, p.rlo - x + d));
+    const auto hi = hn::Xor(lhi, hn::LoadU(d16, p.rhi - x + d));
     return hn::Add(hn::PopulationCount(lo), hn::PopulationCount(hi));
   }
 }
 
-/// Column sums V[x][d] for the columns x >= xb: adds the costs of input row `add` and, when
-/// sub >= 0, subtracts those of row `sub` (u16 arithmetic is exact modulo 2^16 and the true sums
-/// fit in 16 bits, so the result is exact).
-template <bool kCensus, class D16>
-void UpdateColumns(D16 d16, const FastJob& j, int add, int sub, std::uint16_t* HWY_RESTRICT v) {
+/// Column x of the column sums V[x][d] (`col`): adds the costs of row `a` and, when kSub,
+/// subtracts those of row `s` (u16 arithmetic is exact modulo 2^16 and the true sums fit in 16
+/// bits, so the result is exact). kNV: vectors per disparity range, 0 = nd / Lanes at run time.
+/// Returns the first vector of the updated column (kNV > 0 callers reload the rest from L1).
+template <bool kCensus, bool kSub, int kNV, class D16>
+HWY_INLINE void UpdateColumn(D16 d16, const RowPtrs& a, const RowPtrs& s, int x, int nd,
+                             std::uint16_t* HWY_RESTRICT col) {
   const int n = static_cast<int>(hn::Lanes(d16));
-  const int xb = j.min_disp + j.num_disp - 1, nd = j.num_disp;
-  const size_t step = kCensus ? j.step16 : j.step8;
-  const size_t off_add = static_cast<size_t>(add) * step;
-  const size_t off_sub = static_cast<size_t>(sub < 0 ? 0 : sub) * step;
-  for (int x = xb; x < j.width; ++x) {
-    std::uint16_t* dst = v + static_cast<size_t>(x - xb) * nd;
-    for (int d = 0; d < nd; d += n) {
-      auto acc = hn::Add(hn::Load(d16, dst + d), CostAt<kCensus>(d16, j, off_add, x, d));
-      if (sub >= 0) acc = hn::Sub(acc, CostAt<kCensus>(d16, j, off_sub, x, d));
-      hn::Store(acc, d16, dst + d);
+  hn::Vec<D16> la, ha, ls, hs;
+  if constexpr (kCensus) {
+    la = hn::Set(d16, a.llo[x]);
+    ha = hn::Set(d16, a.lhi[x]);
+    if constexpr (kSub) {
+      ls = hn::Set(d16, s.llo[x]);
+      hs = hn::Set(d16, s.lhi[x]);
     }
+  } else {
+    la = hn::Set(d16, a.l8[x]);
+    ha = la;
+    if constexpr (kSub) {
+      ls = hn::Set(d16, s.l8[x]);
+      hs = ls;
+    }
+  }
+  const int end = kNV > 0 ? kNV * n : nd;
+#if HWY_TARGET != HWY_SCALAR
+  if constexpr (!kCensus && kSub && kNV > 0 && kNV % 2 == 0 && hn::MaxLanes(d16) >= 8) {
+    // Two vectors at once from full-width u8 vectors: |l - r| of both rows in u8, their
+    // difference in i8 (both are at most 2 * 63), widened and added.
+    const hn::Repartition<std::uint8_t, D16> d8;
+    const hn::Repartition<std::int8_t, D16> di8;
+    const hn::Half<decltype(di8)> dh8;
+    const hn::Repartition<std::int16_t, D16> di16;
+    const auto l8a = hn::Set(d8, a.l8[x]), l8s = hn::Set(d8, s.l8[x]);
+    for (int d = 0; d < end; d += 2 * n) {
+      const auto ra8 = hn::LoadU(d8, a.r8 - x + d), rs8 = hn::LoadU(d8, s.r8 - x + d);
+      const auto da = hn::Sub(hn::Max(l8a, ra8), hn::Min(l8a, ra8));
+      const auto ds = hn::Sub(hn::Max(l8s, rs8), hn::Min(l8s, rs8));
+      const auto delta = hn::BitCast(di8, hn::Sub(da, ds));
+      const auto lo = hn::BitCast(d16, hn::PromoteTo(di16, hn::LowerHalf(dh8, delta)));
+      const auto hi = hn::BitCast(d16, hn::PromoteTo(di16, hn::UpperHalf(dh8, delta)));
+      hn::Store(hn::Add(hn::Load(d16, col + d), lo), d16, col + d);
+      hn::Store(hn::Add(hn::Load(d16, col + d + n), hi), d16, col + d + n);
+    }
+    return;
+  }
+#endif
+  for (int d = 0; d < end; d += n) {
+    auto acc = hn::Add(hn::Load(d16, col + d), CostAt<kCensus>(d16, a, la, ha, x, d));
+    if constexpr (kSub) acc = hn::Sub(acc, CostAt<kCensus>(d16, s, ls, hs, x, d));
+    hn::Store(acc, d16, col + d);
   }
 }
 
@@ -114,75 +176,178 @@ HWY_INLINE std::uint16_t MinLane(D16 d16, hn::Vec<D16> v) {
   return hn::GetLane(hn::MinOfLanes(d16, v));
 }
 
-template <bool kCensus, class D16>
-void MatchRowsT(D16 d16, const FastJob& j) {
+/// Lane i of the mask as bit i (at most 64 lanes).
+template <class D16>
+HWY_INLINE std::uint64_t MaskBits(D16 d16, hn::Mask<D16> m) {
+#if HWY_TARGET <= HWY_AVX3
+  (void)d16;
+  return static_cast<std::uint64_t>(m.raw);
+#else
+  std::uint8_t bytes[8] = {};
+  hn::StoreMaskBits(d16, m, bytes);
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, bytes, sizeof(bits));
+  return bits;
+#endif
+}
+
+/// Bit p of 64-bit word w of a bitmap (0 when p is in another word or negative).
+HWY_INLINE std::uint64_t BitIn(int w, int p) {
+  return (p >> 6) == w ? std::uint64_t{1} << (p & 63) : 0;
+}
+
+/// One row's block sums, winners and checks, fused: for each output pixel the newest column of V
+/// is updated (when kSub: the row moved down by one), added to the running horizontal sums S,
+/// which are reduced at once (winner, uniqueness, sub-pixel) and then lose their oldest column.
+/// kNV: vectors per disparity range, S and the reductions in registers and 64-bit masks; 0 =
+/// any range, S in memory, reduced vector by vector.
+template <bool kCensus, bool kSub, int kNV, class D16>
+void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
+  constexpr int kMaxNV = kNV > 0 ? kNV : 1;
   const int n = static_cast<int>(hn::Lanes(d16));
+  const int nd = j.num_disp, h = j.half, nv = kNV > 0 ? kNV : nd / n;
+  const int xb = j.min_disp + nd - 1;  // first column with a full search range
+  const int x0 = xb + h, nout = j.width - h - x0;
+  const int row = y - (j.y_begin - h);  // input row of y
+  const RowPtrs ra = RowAt(j, row + h), rs = RowAt(j, kSub ? row - h - 1 : 0);
+  std::uint16_t* HWY_RESTRICT v = j.v;
+  std::uint16_t* HWY_RESTRICT sacc = j.sacc;  // S when kNV == 0, nd lanes
+  const int u = j.uniqueness;
+
+  hn::Vec<D16> sr[kMaxNV];  // S when kNV > 0
+  for (int k = 0; k < kMaxNV; ++k) sr[k] = hn::Zero(d16);
+  if constexpr (kNV == 0) std::fill(sacc, sacc + nd, std::uint16_t{0});
+  for (int c = 0; c < 2 * h; ++c) {
+    std::uint16_t* col = v + static_cast<size_t>(c) * nd;
+    if constexpr (kSub) UpdateColumn<kCensus, true, kNV>(d16, ra, rs, xb + c, nd, col);
+    for (int k = 0; k < nv; ++k) {
+      if constexpr (kNV > 0) {
+        sr[k] = hn::Add(sr[k], hn::Load(d16, col + k * n));
+      } else {
+        hn::Store(hn::Add(hn::Load(d16, sacc + k * n), hn::Load(d16, col + k * n)), d16,
+                  sacc + k * n);
+      }
+    }
+  }
+
+  std::int16_t* HWY_RESTRICT out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step + x0;
+  const std::uint8_t* HWY_RESTRICT tex =
+      j.texture_ok + static_cast<size_t>(y - j.y_begin) * j.texture_step + x0;
+  std::uint16_t* HWY_RESTRICT s = j.s;
+  std::uint16_t* HWY_RESTRICT mins = j.mins;
+  std::uint16_t* HWY_RESTRICT threshs = j.threshs;
+  // Pass 1: block sums of every pixel of the row (kept in s) and their minimum. Nothing here
+  // waits on a reduction, so consecutive pixels overlap in the core.
+  for (int i = 0; i < nout; ++i) {
+    std::uint16_t* HWY_RESTRICT col = v + static_cast<size_t>(i + 2 * h) * nd;
+    if constexpr (kSub) UpdateColumn<kCensus, true, kNV>(d16, ra, rs, xb + i + 2 * h, nd, col);
+    std::uint16_t* HWY_RESTRICT c = s + static_cast<size_t>(i) * nd;
+    auto vmin = hn::Set(d16, std::uint16_t{0xFFFF});
+    for (int k = 0; k < nv; ++k) {
+      hn::Vec<D16> sk;
+      if constexpr (kNV > 0) {
+        sr[k] = hn::Add(sr[k], hn::Load(d16, col + k * n));
+        sk = sr[k];
+      } else {
+        sk = hn::Add(hn::Load(d16, sacc + k * n), hn::Load(d16, col + k * n));
+      }
+      hn::Store(sk, d16, c + k * n);
+      vmin = hn::Min(vmin, sk);
+    }
+    mins[i] = MinLane(d16, vmin);
+    // The oldest column leaves the window.
+    const std::uint16_t* HWY_RESTRICT old = v + static_cast<size_t>(i) * nd;
+    for (int k = 0; k < nv; ++k) {
+      if constexpr (kNV > 0) {
+        sr[k] = hn::Sub(sr[k], hn::Load(d16, old + k * n));
+      } else {
+        hn::Store(hn::Sub(hn::Add(hn::Load(d16, sacc + k * n), hn::Load(d16, col + k * n)),
+                          hn::Load(d16, old + k * n)),
+                  d16, sacc + k * n);
+      }
+    }
+  }
+  // Uniqueness thresholds of the row (a loop the compiler vectorises).
+  for (int i = 0; i < nout; ++i) {
+    const int m = mins[i];
+    threshs[i] = static_cast<std::uint16_t>(u > 0 ? std::min(m + m * u / 100, 65535) : 0);
+  }
+  // Pass 2: winner: the largest disparity with the smallest sum (StereoBM's choice on ties; the
+  // nearer surface, the cautious one for obstacle warning). Uniqueness: no disparity further than
+  // 1 px from it at or below the threshold. Branch-free: where the winner is is unpredictable.
+  const int min16 = j.min_disp * 16;
+  for (int i = 0; i < nout; ++i) {
+    const std::uint16_t* HWY_RESTRICT c = s + static_cast<size_t>(i) * nd;
+    const int m = mins[i], thresh = threshs[i];
+    const auto vm = hn::Set(d16, mins[i]);
+    const auto vt = hn::Set(d16, threshs[i]);
+    int b = 0;
+    bool unique = true;
+    if constexpr (kNV > 0) {
+      constexpr int kWords = (kNV * hn::MaxLanes(d16) + 63) / 64;
+      std::uint64_t eq[kWords] = {}, le[kWords] = {};
+      for (int k = 0; k < kNV; ++k) {
+        const int w = k * n / 64, sh = k * n % 64;
+        const auto sk = hn::Load(d16, c + k * n);
+        eq[w] |= MaskBits(d16, hn::Eq(sk, vm)) << sh;
+        le[w] |= MaskBits(d16, hn::Eq(hn::Min(sk, vt), sk)) << sh;  // sum <= thresh
+      }
+      for (int w = 0; w < kWords; ++w)  // the last (largest) disparity with the minimum
+        b = eq[w] != 0 ? w * 64 + 63 - static_cast<int>(hwy::Num0BitsAboveMS1Bit_Nonzero64(eq[w]))
+                       : b;
+      std::uint64_t far = 0;
+      if constexpr (kWords == 1) {
+        far = le[0] & ~(b > 0 ? std::uint64_t{7} << (b - 1) : std::uint64_t{3});
+      } else {
+        for (int w = 0; w < kWords; ++w)
+          far |= le[w] & ~(BitIn(w, b - 1) | BitIn(w, b) | BitIn(w, b + 1));
+      }
+      unique = far == 0;
+    } else {
+      size_t count = 0;
+      for (int k = 0; k < nv; ++k) {
+        const auto sk = hn::Load(d16, c + k * n);
+        const std::uint64_t bits = MaskBits(d16, hn::Eq(sk, vm));
+        b = bits != 0 ? k * n + 63 - static_cast<int>(hwy::Num0BitsAboveMS1Bit_Nonzero64(bits)) : b;
+        count += hn::CountTrue(d16, hn::Eq(hn::Min(sk, vt), sk));  // sum <= thresh
+      }
+      const int cm = c[b > 0 ? b - 1 : 0], cp = c[b < nd - 1 ? b + 1 : nd - 1];
+      const size_t near = 1 + static_cast<size_t>(b > 0 && cm <= thresh) +
+                          static_cast<size_t>(b < nd - 1 && cp <= thresh);
+      unique = count == near;
+    }
+    const int cm = c[b > 0 ? b - 1 : 0], cp = c[b < nd - 1 ? b + 1 : nd - 1];
+    const bool ok = tex[i] != 0 && (u <= 0 || unique);
+    const int d16v = (b > 0 && b < nd - 1) ? subpixel_disparity16(b, cm, m, cp) : b * 16;
+    out[i] = ok ? static_cast<std::int16_t>(d16v + min16) : kInvalid16;
+    best[i] = b;
+  }
+}
+
+template <bool kCensus, int kNV, class D16>
+void MatchRowsT(D16 d16, const FastJob& j) {
   const int nd = j.num_disp, h = j.half;
   const int xb = j.min_disp + nd - 1;       // first column with a full search range
   const int x0 = xb + h, x1 = j.width - h;  // output columns
   const int ncols = j.width - xb, nout = x1 - x0;
   std::uint16_t* HWY_RESTRICT v = j.v;
-  std::uint16_t* HWY_RESTRICT s = j.s;
   std::vector<int> best(nout);
   std::fill(v, v + static_cast<size_t>(ncols) * nd, std::uint16_t{0});
-  for (int row = 0; row < 2 * h + 1; ++row) UpdateColumns<kCensus>(d16, j, row, -1, v);
+  for (int row = 0; row < 2 * h + 1; ++row) {
+    const RowPtrs ra = RowAt(j, row);
+    for (int c = 0; c < ncols; ++c)
+      UpdateColumn<kCensus, false, kNV>(d16, ra, ra, xb + c, nd, v + static_cast<size_t>(c) * nd);
+  }
 
   for (int y = j.y_begin; y < j.y_end; ++y) {
-    const int row = y - (j.y_begin - h);  // input row of y
-    if (y > j.y_begin) UpdateColumns<kCensus>(d16, j, row + h, row - h - 1, v);
-    // Horizontal box sums, incremental along x.
-    std::uint16_t* s0 = s;
-    for (int d = 0; d < nd; d += n) {
-      auto acc = hn::Zero(d16);
-      for (int k = 0; k < 2 * h + 1; ++k)
-        acc = hn::Add(acc, hn::Load(d16, v + static_cast<size_t>(k) * nd + d));
-      hn::Store(acc, d16, s0 + d);
-    }
-    for (int i = 1; i < nout; ++i) {
-      const std::uint16_t* add = v + static_cast<size_t>(i + 2 * h) * nd;
-      const std::uint16_t* sub = v + static_cast<size_t>(i - 1) * nd;
-      const std::uint16_t* prev = s + static_cast<size_t>(i - 1) * nd;
-      std::uint16_t* cur = s + static_cast<size_t>(i) * nd;
-      for (int d = 0; d < nd; d += n) {
-        const auto sum = hn::Sub(hn::Add(hn::Load(d16, prev + d), hn::Load(d16, add + d)),
-                                 hn::Load(d16, sub + d));
-        hn::Store(sum, d16, cur + d);
-      }
-    }
-    // Winner takes all, uniqueness, texture, sub-pixel.
-    std::int16_t* out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step;
-    const std::uint8_t* tex = j.texture_ok + static_cast<size_t>(y - j.y_begin) * j.texture_step;
-    for (int i = 0; i < nout; ++i) {
-      out[x0 + i] = kInvalid16;
-      if (!tex[x0 + i]) continue;
-      const std::uint16_t* c = s + static_cast<size_t>(i) * nd;
-      auto vmin = hn::Load(d16, c);
-      for (int d = n; d < nd; d += n) vmin = hn::Min(vmin, hn::Load(d16, c + d));
-      const std::uint16_t m = MinLane(d16, vmin);
-      const auto vm = hn::Set(d16, m);
-      int b = -1;
-      size_t count = 0;  // disparities within the uniqueness threshold
-      const int thresh = j.uniqueness > 0 ? std::min(m + m * j.uniqueness / 100, 65535) : -1;
-      const auto vt = hn::Set(d16, static_cast<std::uint16_t>(std::max(thresh, 0)));
-      // Branch-free over the (few) vectors: which vector holds the winner is unpredictable.
-      for (int d = 0; d < nd; d += n) {
-        const auto cv = hn::Load(d16, c + d);
-        const intptr_t f = hn::FindFirstTrue(d16, hn::Eq(cv, vm));
-        b = (b < 0 && f >= 0) ? d + static_cast<int>(f) : b;
-        if (thresh >= 0) count += hn::CountTrue(d16, hn::Eq(hn::Min(cv, vt), cv));
-      }
-      best[i] = b;
-      if (thresh >= 0) {
-        for (int d = std::max(b - 1, 0); d <= std::min(b + 1, nd - 1); ++d)
-          count -= c[d] <= thresh ? 1 : 0;
-        if (count != 0) continue;
-      }
-      const int d16v =
-          (b > 0 && b < nd - 1) ? subpixel_disparity16(b, c[b - 1], c[b], c[b + 1]) : b * 16;
-      out[x0 + i] = static_cast<std::int16_t>(d16v + j.min_disp * 16);
-    }
+    if (y > j.y_begin)
+      MatchRow<kCensus, true, kNV>(d16, j, y, best.data());
+    else
+      MatchRow<kCensus, false, kNV>(d16, j, y, best.data());
     if (j.lr_max_diff >= 0) {
       // Right image's winners: right pixel xr is seen by left pixel xr + min_disp + d at d.
+      const std::uint16_t* s = j.s;
+      std::int16_t* out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step;
       std::vector<int> rbest(j.width, -1), rcost(j.width, INT_MAX);
       for (int i = 0; i < nout; ++i) {
         const std::uint16_t* c = s + static_cast<size_t>(i) * nd;
@@ -204,6 +369,22 @@ void MatchRowsT(D16 d16, const FastJob& j) {
   }
 }
 
+template <bool kCensus, class D16>
+void MatchRowsNV(D16 d16, const FastJob& j) {
+  switch (j.num_disp / static_cast<int>(hn::Lanes(d16))) {
+    case 1:
+      return MatchRowsT<kCensus, 1>(d16, j);
+    case 2:
+      return MatchRowsT<kCensus, 2>(d16, j);
+    case 4:
+      return MatchRowsT<kCensus, 4>(d16, j);
+    case 8:
+      return MatchRowsT<kCensus, 8>(d16, j);
+    default:
+      return MatchRowsT<kCensus, 0>(d16, j);
+  }
+}
+
 /// Full-width vectors when the range is a whole number of them (AVX-512: 32 lanes), else at
 /// most 16 lanes, which every multiple of 16 disparities fills.
 void MatchRows(const FastJob& j) {
@@ -212,15 +393,143 @@ void MatchRows(const FastJob& j) {
   const bool use_full = j.num_disp % static_cast<int>(hn::Lanes(full)) == 0;
   if (j.census) {
     if (use_full)
-      MatchRowsT<true>(full, j);
+      MatchRowsNV<true>(full, j);
     else
-      MatchRowsT<true>(capped, j);
+      MatchRowsNV<true>(capped, j);
   } else {
     if (use_full)
-      MatchRowsT<false>(full, j);
+      MatchRowsNV<false>(full, j);
     else
-      MatchRowsT<false>(capped, j);
+      MatchRowsNV<false>(capped, j);
   }
+}
+
+/// StereoBM's x-Sobel prefilter of one row (as fast_detail::prefilter_rows, which is the
+/// reference): rows a, b, c are the rows above, at and below; out[0] = out[width - 1] = cap.
+/// When `reverse`, the row is written reversed (out[width - 1 - x]).
+void PrefilterRow(const std::uint8_t* HWY_RESTRICT a, const std::uint8_t* HWY_RESTRICT b,
+                  const std::uint8_t* HWY_RESTRICT c, int width, int cap, bool reverse,
+                  std::uint8_t* HWY_RESTRICT out) {
+  const hn::ScalableTag<std::int16_t> di;
+  const hn::Rebind<std::uint8_t, decltype(di)> d8;
+  const int n = static_cast<int>(hn::Lanes(di));
+  const auto vcap = hn::Set(di, static_cast<std::int16_t>(cap));
+  const auto vneg = hn::Set(di, static_cast<std::int16_t>(-cap));
+  const auto load = [&](const std::uint8_t* p) { return hn::PromoteTo(di, hn::LoadU(d8, p)); };
+  const auto at = [&](int x) { return reverse ? width - 1 - x : x; };
+  out[0] = static_cast<std::uint8_t>(cap);
+  out[width - 1] = static_cast<std::uint8_t>(cap);
+  int x = 1;
+  for (; x + n <= width - 1; x += n) {
+    const auto ga = hn::Sub(load(a + x + 1), load(a + x - 1));
+    const auto gb = hn::Sub(load(b + x + 1), load(b + x - 1));
+    const auto gc = hn::Sub(load(c + x + 1), load(c + x - 1));
+    const auto g = hn::Add(hn::Add(ga, gc), hn::Add(gb, gb));
+    auto v = hn::Add(hn::Min(hn::Max(g, vneg), vcap), vcap);
+    if (reverse) {
+      v = hn::Reverse(di, v);
+      hn::StoreU(hn::DemoteTo(d8, v), d8, out + (width - x - n));
+    } else {
+      hn::StoreU(hn::DemoteTo(d8, v), d8, out + x);
+    }
+  }
+  for (; x + 1 < width; ++x) {
+    const int g = (a[x + 1] - a[x - 1]) + 2 * (b[x + 1] - b[x - 1]) + (c[x + 1] - c[x - 1]);
+    out[at(x)] = static_cast<std::uint8_t>(std::clamp(g, -cap, cap) + cap);
+  }
+}
+
+/// 5x5 census signatures of one row (as fast_detail::census_rows, which is the reference), split
+/// into their low 16 and high 8 bits. `pad`: the 5 rows y - 2 .. y + 2 with the border replicated,
+/// each width + 4 long, pixel x at index x + 2. When `reverse`, the row is written reversed.
+void CensusRow(const std::uint8_t* HWY_RESTRICT pad, int width, bool reverse,
+               std::uint16_t* HWY_RESTRICT lo, std::uint16_t* HWY_RESTRICT hi) {
+  const hn::ScalableTag<std::uint16_t> d16;
+  const hn::Rebind<std::int16_t, decltype(d16)> di;  // pixels compared as signed 16-bit
+  const hn::Rebind<std::uint8_t, decltype(d16)> d8;
+  const int n = static_cast<int>(hn::Lanes(d16));
+  const int r = kCensusRadius, pw = width + 2 * r;
+  const auto one = hn::Set(d16, std::uint16_t{1});
+  int x = 0;
+  for (; x + n <= width; x += n) {
+    const auto centre = hn::PromoteTo(di, hn::LoadU(d8, pad + r * pw + r + x));
+    auto vlo = hn::Zero(d16), vhi = hn::Zero(d16);
+    int k = 0;
+    for (int dy = -r; dy <= r; ++dy) {
+      for (int dx = -r; dx <= r; ++dx) {
+        if (dy == 0 && dx == 0) continue;
+        const auto nb = hn::PromoteTo(di, hn::LoadU(d8, pad + (dy + r) * pw + r + dx + x));
+        const auto bit =
+            hn::And(hn::VecFromMask(d16, hn::RebindMask(d16, hn::Lt(nb, centre))), one);
+        if (k < 8)
+          vhi = hn::Or(hn::Add(vhi, vhi), bit);
+        else
+          vlo = hn::Or(hn::Add(vlo, vlo), bit);
+        ++k;
+      }
+    }
+    if (reverse) {
+      hn::StoreU(hn::Reverse(d16, vlo), d16, lo + (width - x - n));
+      hn::StoreU(hn::Reverse(d16, vhi), d16, hi + (width - x - n));
+    } else {
+      hn::StoreU(vlo, d16, lo + x);
+      hn::StoreU(vhi, d16, hi + x);
+    }
+  }
+  for (; x < width; ++x) {
+    const int c = pad[r * pw + r + x];
+    std::uint32_t code = 0;
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx)
+        if (dy != 0 || dx != 0)
+          code = (code << 1) | static_cast<std::uint32_t>(pad[(dy + r) * pw + r + dx + x] < c);
+    const int at = reverse ? width - 1 - x : x;
+    lo[at] = static_cast<std::uint16_t>(code & 0xFFFF);
+    hi[at] = static_cast<std::uint16_t>(code >> 16);
+  }
+}
+
+/// Texture column sums: sums[x] += |add[x] - cap| and, when `sub`, -= |sub[x] - cap| (u16, exact
+/// modulo 2^16; the true sums fit).
+void TextureColumns(const std::uint8_t* HWY_RESTRICT add, const std::uint8_t* HWY_RESTRICT sub,
+                    int width, int cap, std::uint16_t* HWY_RESTRICT sums) {
+  const hn::ScalableTag<std::uint16_t> d16;
+  const hn::Rebind<std::uint8_t, decltype(d16)> d8;
+  const int n = static_cast<int>(hn::Lanes(d16));
+  const auto vcap = hn::Set(d16, static_cast<std::uint16_t>(cap));
+  const auto absdiff = [&](const std::uint8_t* p) {
+    const auto v = hn::PromoteTo(d16, hn::LoadU(d8, p));
+    return hn::Sub(hn::Max(v, vcap), hn::Min(v, vcap));
+  };
+  int x = 0;
+  for (; x + n <= width; x += n) {
+    auto s = hn::Add(hn::LoadU(d16, sums + x), absdiff(add + x));
+    if (sub != nullptr) s = hn::Sub(s, absdiff(sub + x));
+    hn::StoreU(s, d16, sums + x);
+  }
+  for (; x < width; ++x) {
+    int s = sums[x] + std::abs(add[x] - cap);
+    if (sub != nullptr) s -= std::abs(sub[x] - cap);
+    sums[x] = static_cast<std::uint16_t>(s);
+  }
+}
+
+/// 1/16 px disparities (kInvalid16 = invalid) to px floats (invalid = -1), as store_disparity16.
+void StoreRow(const std::int16_t* HWY_RESTRICT src, int width, float* HWY_RESTRICT dst) {
+  const hn::ScalableTag<float> df;
+  const hn::Rebind<std::int32_t, decltype(df)> di32;
+  const hn::Rebind<std::int16_t, decltype(df)> di16;
+  const int n = static_cast<int>(hn::Lanes(df));
+  const auto inv = hn::Set(di32, static_cast<std::int32_t>(kInvalid16));
+  const auto scale = hn::Set(df, 1.0f / 16.0f);  // exact: a power of two
+  const auto minus1 = hn::Set(df, -1.0f);
+  int x = 0;
+  for (; x + n <= width; x += n) {
+    const auto v = hn::PromoteTo(di32, hn::LoadU(di16, src + x));
+    const auto f = hn::Mul(hn::ConvertTo(df, v), scale);
+    hn::StoreU(hn::IfThenElse(hn::RebindMask(df, hn::Eq(v, inv)), minus1, f), df, dst + x);
+  }
+  for (; x < width; ++x) dst[x] = src[x] == kInvalid16 ? -1.0f : static_cast<float>(src[x]) / 16.0f;
 }
 
 std::int64_t CurrentTarget() { return HWY_TARGET; }
@@ -234,29 +543,21 @@ namespace sg::vision {
 namespace fast_detail {
 HWY_EXPORT(MatchRows);
 HWY_EXPORT(CurrentTarget);
+HWY_EXPORT(PrefilterRow);
+HWY_EXPORT(CensusRow);
+HWY_EXPORT(TextureColumns);
+HWY_EXPORT(StoreRow);
 
 namespace {
-/// Copies each row of `rows` (elements of type T) through `f` into the continuous buffer `out`,
-/// reversed when `reverse`.
-template <typename Out, typename T, typename F>
-void plane(const cv::Mat& rows, bool reverse, F f, std::vector<Out>& out) {
-  const int w = rows.cols;
-  out.resize(static_cast<size_t>(rows.rows) * w);
-  for (int y = 0; y < rows.rows; ++y) {
-    const T* src = rows.ptr<T>(y);
-    Out* dst = out.data() + static_cast<size_t>(y) * w;
-    for (int x = 0; x < w; ++x) dst[reverse ? w - 1 - x : x] = f(src[x]);
-  }
-}
-
 /// Buffers reused across calls on one thread: allocating megabytes per frame costs page faults.
 /// They hold no state that reaches the output.
 struct Scratch {
-  cv::Mat pl, pr, cl, cr, integral, tex_ok, out16;
-  std::vector<std::uint8_t> r8;
+  cv::Mat pl, tex_ok, out16;
+  std::vector<std::uint8_t> r8, pad;
+  std::vector<std::uint16_t> tex_cols;
   std::vector<std::uint16_t> llo, lhi, rlo, rhi;
-  hwy::AlignedFreeUniquePtr<std::uint16_t[]> v, s;
-  size_t v_size = 0, s_size = 0;
+  hwy::AlignedFreeUniquePtr<std::uint16_t[]> v, s, small;
+  size_t v_size = 0, s_size = 0, small_size = 0;
 };
 
 std::uint16_t* aligned(hwy::AlignedFreeUniquePtr<std::uint16_t[]>& p, size_t& size, size_t need) {
@@ -299,24 +600,58 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
 
   thread_local Scratch scratch;
   Scratch& sc = scratch;
-  cv::Mat &pl = sc.pl, &pr = sc.pr, &cl = sc.cl, &cr = sc.cr;
-  prefilter_rows(left, p.prefilter_cap, ya, yb, pl);  // SAD cost and texture
+  cv::Mat& pl = sc.pl;
+  // Prefiltered rows (SAD cost and texture), right rows reversed; SIMD, equal to prefilter_rows.
+  const auto reflect = [height](int y) {
+    if (height == 1) return 0;
+    return y < 0 ? -y : (y >= height ? 2 * height - 2 - y : y);
+  };
+  const auto prefilter = [&](const cv::Mat& img, bool reverse, std::uint8_t* dst) {
+    for (int y = ya; y < yb; ++y)
+      if (height % 2 == 1 && y == height - 1 && height > 1)  // flat, as StereoBM
+        std::fill(dst + static_cast<size_t>(y - ya) * width,
+                  dst + static_cast<size_t>(y - ya + 1) * width,
+                  static_cast<std::uint8_t>(p.prefilter_cap));
+      else
+        HWY_DYNAMIC_DISPATCH(PrefilterRow)
+    (img.ptr<std::uint8_t>(reflect(y - 1)), img.ptr<std::uint8_t>(y),
+     img.ptr<std::uint8_t>(reflect(y + 1)), width, p.prefilter_cap, reverse,
+     dst + static_cast<size_t>(y - ya) * width);
+  };
+  pl.create(yb - ya, width, CV_8U);
+  prefilter(left, false, pl.ptr<std::uint8_t>(0));
   if (!job.census) {
-    prefilter_rows(right, p.prefilter_cap, ya, yb, pr);
-    const auto same = [](std::uint8_t v) { return v; };
-    plane<std::uint8_t, std::uint8_t>(pr, true, same, sc.r8);
+    sc.r8.resize(static_cast<size_t>(yb - ya) * width);
+    prefilter(right, true, sc.r8.data());
     job.step8 = static_cast<size_t>(width);  // pl is continuous: created above
     job.left8 = pl.ptr<std::uint8_t>(0);
     job.right8_rev = sc.r8.data();
   } else {
-    census_rows(left, ya, yb, cl);
-    census_rows(right, ya, yb, cr);
-    const auto lo = [](int v) { return static_cast<std::uint16_t>(v & 0xFFFF); };
-    const auto hi = [](int v) { return static_cast<std::uint16_t>(v >> 16); };
-    plane<std::uint16_t, int>(cl, false, lo, sc.llo);
-    plane<std::uint16_t, int>(cl, false, hi, sc.lhi);
-    plane<std::uint16_t, int>(cr, true, lo, sc.rlo);
-    plane<std::uint16_t, int>(cr, true, hi, sc.rhi);
+    // Census planes (SIMD, equal to census_rows): rows padded with the replicated border.
+    const int r = kCensusRadius, pw = width + 2 * r;
+    std::vector<std::uint8_t>& pad = sc.pad;
+    pad.resize(static_cast<size_t>(2 * r + 1) * pw);
+    const auto census = [&](const cv::Mat& img, bool reverse, std::vector<std::uint16_t>& lo,
+                            std::vector<std::uint16_t>& hi) {
+      lo.resize(static_cast<size_t>(yb - ya) * width);
+      hi.resize(lo.size());
+      for (int y = ya; y < yb; ++y) {
+        for (int k = -r; k <= r; ++k) {
+          const std::uint8_t* src = img.ptr<std::uint8_t>(std::clamp(y + k, 0, height - 1));
+          std::uint8_t* dst = pad.data() + static_cast<size_t>(k + r) * pw;
+          std::memcpy(dst + r, src, width);
+          for (int i = 0; i < r; ++i) {
+            dst[i] = src[0];
+            dst[r + width + i] = src[width - 1];
+          }
+        }
+        const size_t off = static_cast<size_t>(y - ya) * width;
+        HWY_DYNAMIC_DISPATCH(CensusRow)
+        (pad.data(), width, reverse, lo.data() + off, hi.data() + off);
+      }
+    };
+    census(left, false, sc.llo, sc.lhi);
+    census(right, true, sc.rlo, sc.rhi);
     job.step16 = static_cast<size_t>(width);
     job.left_lo = sc.llo.data();
     job.left_hi = sc.lhi.data();
@@ -324,32 +659,27 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
     job.right_hi_rev = sc.rhi.data();
   }
 
-  // Texture: block sums of |prefiltered - cap| from an integral image (exact integers).
-  cv::Mat& integral = sc.integral;
-  integral.create(pl.rows + 1, width + 1, CV_32S);
-  integral.row(0).setTo(0);
-  for (int y = 0; y < pl.rows; ++y) {
-    const std::uint8_t* src = pl.ptr<std::uint8_t>(y);
-    const int* above = integral.ptr<int>(y);
-    int* dst = integral.ptr<int>(y + 1);
-    dst[0] = 0;
-    int row_sum = 0;
-    for (int x = 0; x < width; ++x) {
-      row_sum += std::abs(src[x] - p.prefilter_cap);
-      dst[x + 1] = above[x + 1] + row_sum;
-    }
-  }
+  // Texture: block sums of |prefiltered - cap|, column sums moved down row by row, then a running
+  // sum along the row (exact integers).
   cv::Mat& tex_ok = sc.tex_ok;
   tex_ok.create(y1 - y0, width, CV_8U);
   tex_ok.setTo(0);
   const int b = 2 * h + 1;
+  sc.tex_cols.assign(width, 0);
+  std::uint16_t* cols = sc.tex_cols.data();
+  for (int r = 0; r < b; ++r) HWY_DYNAMIC_DISPATCH(TextureColumns)
+  (pl.ptr<std::uint8_t>(r), nullptr, width, p.prefilter_cap, cols);
   for (int y = y0; y < y1; ++y) {
-    const int* top = integral.ptr<int>(y - h - ya);
-    const int* bottom = integral.ptr<int>(y - h - ya + b);
+    if (y > y0) HWY_DYNAMIC_DISPATCH(TextureColumns)
+    (pl.ptr<std::uint8_t>(y + h - ya), pl.ptr<std::uint8_t>(y - h - 1 - ya), width, p.prefilter_cap,
+     cols);
     std::uint8_t* ok = tex_ok.ptr<std::uint8_t>(y - y0);
+    int sum = 0;
+    for (int x = 0; x < 2 * h; ++x) sum += cols[x];
     for (int x = h; x < width - h; ++x) {
-      const int sum = bottom[x + h + 1] - bottom[x - h] - top[x + h + 1] + top[x - h];
+      sum += cols[x + h];
       ok[x] = sum >= p.texture_threshold ? 1 : 0;
+      sum -= cols[x - h];
     }
   }
   job.texture_ok = tex_ok.ptr<std::uint8_t>(0);
@@ -360,11 +690,16 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
   out16.setTo(kInvalid16);
   const int xb = md + nd - 1;
   job.v = aligned(sc.v, sc.v_size, static_cast<size_t>(width - xb) * nd);
-  job.s = aligned(sc.s, sc.s_size, static_cast<size_t>(width - h - (xb + h)) * nd);
+  const size_t nout = static_cast<size_t>(width - h - (xb + h));
+  job.s = aligned(sc.s, sc.s_size, nout * nd);
+  job.sacc = aligned(sc.small, sc.small_size, static_cast<size_t>(nd) + 2 * nout + 64);
+  job.mins = job.sacc + nd;
+  job.threshs = job.mins + nout;
   job.out = out16.ptr<std::int16_t>(0);
   job.out_step = out16.step1();
   HWY_DYNAMIC_DISPATCH(MatchRows)(job);
-  store_disparity16(out16, y0, disp);
+  for (int y = y0; y < y1; ++y)
+    HWY_DYNAMIC_DISPATCH(StoreRow)(out16.ptr<std::int16_t>(y - y0), width, disp.ptr<float>(y));
 }
 
 }  // namespace sg::vision

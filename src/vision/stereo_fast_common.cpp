@@ -13,7 +13,7 @@ int clamp_index(int i, int n) { return std::clamp(i, 0, n - 1); }
 
 void prefilter_rows(const cv::Mat& img, int cap, int r0, int r1, cv::Mat& out) {
   // Borders as StereoBM's prefilter: rows reflected without repeating the edge (row -1 = row 1),
-  // first and last columns set to cap (no gradient).
+  // first and last columns set to cap (no gradient), and an odd height's last row too.
   const int width = img.cols, height = img.rows;
   out.create(r1 - r0, width, CV_8U);
   auto reflect = [height](int y) {
@@ -25,6 +25,11 @@ void prefilter_rows(const cv::Mat& img, int cap, int r0, int r1, cv::Mat& out) {
     const std::uint8_t* b = img.ptr<std::uint8_t>(y);
     const std::uint8_t* c = img.ptr<std::uint8_t>(reflect(y + 1));
     std::uint8_t* o = out.ptr<std::uint8_t>(y - r0);
+    if (height % 2 == 1 && y == height - 1 && height > 1) {
+      // StereoBM filters rows in pairs and leaves an odd height's last row flat (= cap).
+      std::fill(o, o + width, static_cast<std::uint8_t>(cap));
+      continue;
+    }
     o[0] = static_cast<std::uint8_t>(cap);
     for (int x = 1; x + 1 < width; ++x) {
       const int v = (a[x + 1] - a[x - 1]) + 2 * (b[x + 1] - b[x - 1]) + (c[x + 1] - c[x - 1]);

@@ -12,7 +12,8 @@ constexpr int kCensusRadius = 2;
 constexpr std::int16_t kInvalid16 = INT16_MIN;
 
 /// StereoBM's x-Sobel prefilter over image rows [r0, r1): value = clamp(Sobel_x, -cap, cap) + cap,
-/// in [0, 2 cap]; borders as StereoBM (rows reflected, first and last columns = cap). out: CV_8U,
+/// in [0, 2 cap]; borders as StereoBM (rows reflected, first and last columns = cap, and the last
+/// row = cap when the height is odd: StereoBM filters rows in pairs). out: CV_8U,
 /// (r1 - r0) x width.
 void prefilter_rows(const cv::Mat& img, int cap, int r0, int r1, cv::Mat& out);
 

@@ -53,7 +53,7 @@ void match_fast_reference(const cv::Mat& left, const cv::Mat& right, const core:
       const int* c = &cost[static_cast<size_t>(x) * nd];
       int b = 0;
       for (int d = 1; d < nd; ++d)
-        if (c[d] < c[b]) b = d;
+        if (c[d] <= c[b]) b = d;  // ties: the largest disparity, as StereoBM
       best[x] = b;
       int texture = 0;
       for (int dy = -h; dy <= h; ++dy)

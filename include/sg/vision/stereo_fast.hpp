@@ -7,7 +7,8 @@
 /// num_disparities): the cost of a pixel pair is the absolute difference of the x-Sobel
 /// prefiltered images (StereoBM's prefilter, clipped to +-prefilter_cap) or the Hamming distance
 /// of 5x5 census signatures; costs are summed over a block_size x block_size block (integers,
-/// incremental box sums); the smallest sum wins (first one on ties). A pixel is invalid when its
+/// incremental box sums); the smallest sum wins (on ties the largest disparity, as StereoBM: the
+/// nearer surface). A pixel is invalid when its
 /// block's texture (sum of |prefiltered|) is below texture_threshold, when another disparity
 /// further than 1 px away costs at most (100 + uniqueness_ratio) % of the winner, or, with
 /// lr_max_diff >= 0, when the right image's winner differs by more than lr_max_diff px. Sub-pixel
