@@ -6,7 +6,6 @@
 #include <fstream>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
-#include <regex>
 #include <sstream>
 
 #include "sg/core/error.hpp"
@@ -23,15 +22,39 @@ bool little_endian_host() {
   return b == 1;
 }
 
-/// Scales listed in an OpenCV datasets.xml (lines `name "scale" "unknown"`); empty if none.
+/// `"text"` -> text; false when `word` is not one quoted run of [0-9.].
+bool quoted_number_text(const std::string& word, std::string& text) {
+  if (word.size() < 3 || word.front() != '"' || word.back() != '"') return false;
+  text = word.substr(1, word.size() - 2);
+  return text.find_first_not_of("0123456789.") == std::string::npos;
+}
+
+/// Scales listed in an OpenCV datasets.xml (lines `name "scale" "unknown"`; other lines are
+/// ignored); empty if none. Throws InputError naming the file and line when a scale is not a
+/// finite number > 0 (e.g. "." or "1.2.3").
 std::map<std::string, double> read_dataset_scales(const fs::path& xml) {
   std::map<std::string, double> out;
   std::ifstream in(xml);
-  const std::regex line(R"(^\s*([A-Za-z0-9_\-]+)\s+\"([0-9.]+)\"\s+\"[0-9.]+\"\s*$)");
   std::string text;
-  std::smatch m;
-  while (std::getline(in, text))
-    if (std::regex_match(text, m, line)) out[m[1]] = std::stod(m[2]);
+  for (int line_no = 1; std::getline(in, text); ++line_no) {
+    std::istringstream words(text);
+    std::string name, scale_word, unknown_word, extra, scale_text, unknown_text;
+    if (!(words >> name >> scale_word >> unknown_word) || (words >> extra)) continue;
+    if (name.find_first_not_of(
+            "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") !=
+            std::string::npos ||
+        !quoted_number_text(scale_word, scale_text) ||
+        !quoted_number_text(unknown_word, unknown_text)) {
+      continue;
+    }
+    char* end = nullptr;
+    const double scale = std::strtod(scale_text.c_str(), &end);
+    if (end != scale_text.c_str() + scale_text.size() || !std::isfinite(scale) || !(scale > 0)) {
+      throw core::InputError(xml.string() + ":" + std::to_string(line_no) + ": scale \"" +
+                             scale_text + "\" of '" + name + "' is not a number > 0");
+    }
+    out[name] = scale;
+  }
   return out;
 }
 
@@ -91,6 +114,18 @@ cv::Mat read_pfm(const fs::path& path) {
     throw core::InputError(path.string() + ": not a one-channel PFM file (\"Pf\" header)");
   }
   in.get();  // the single whitespace byte after the scale
+  // The header alone must not make us allocate: 17 bytes can announce 65536 x 65536 floats.
+  const std::streamoff data_at = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff file_size = in.tellg();
+  in.seekg(data_at);
+  const std::streamoff needed = static_cast<std::streamoff>(width) * height * 4;
+  if (data_at < 0 || file_size - data_at < needed) {
+    throw core::InputError(path.string() + ": PFM file is truncated (" + std::to_string(width) +
+                           "x" + std::to_string(height) + " needs " + std::to_string(needed) +
+                           " bytes of data, the file holds " +
+                           std::to_string(std::max<std::streamoff>(0, file_size - data_at)) + ")");
+  }
   cv::Mat out(height, width, CV_32F);
   const bool swap = (scale < 0) != little_endian_host();
   std::vector<unsigned char> row(static_cast<size_t>(width) * 4);

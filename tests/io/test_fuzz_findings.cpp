@@ -1,0 +1,100 @@
+// Regression tests for what the fuzz targets (tests/fuzz) found in the parsers of user input: each
+// input below once crashed a parser, made it allocate without bound or hit undefined behaviour;
+// now it is a core::InputError naming the file.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "io_test_util.hpp"
+#include "sg/io/sources.hpp"
+#include "sg/io/stereo_gt.hpp"
+
+namespace sg::io {
+namespace {
+
+using testing_util::input_error_of;
+using testing_util::ScratchDir;
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// fuzz_pfm: a 17-byte header announcing 65536 x 65536 floats made read_pfm allocate 16 GiB
+// before finding the data missing (libFuzzer: out-of-memory).
+TEST(FuzzFindings, PfmHeaderLargerThanTheFileIsRefusedBeforeAllocating) {
+  ScratchDir dir;
+  std::ofstream(dir.path() / "big.pfm", std::ios::binary) << "Pf\n65536 65536\n-1\n";
+  const std::string message = input_error_of([&] { read_pfm(dir.path() / "big.pfm"); });
+  EXPECT_TRUE(contains(message, "truncated")) << message;
+  EXPECT_TRUE(contains(message, "needs 17179869184 bytes of data, the file holds 0")) << message;
+  std::ofstream(dir.path() / "short.pfm", std::ios::binary) << "Pf\n2 2\n-1\n"
+                                                            << std::string(15, 'x');
+  EXPECT_TRUE(contains(input_error_of([&] { read_pfm(dir.path() / "short.pfm"); }),
+                       "needs 16 bytes of data, the file holds 15"));
+}
+
+// fuzz_datasets_xml: a scale that std::stod refused ("." -> std::invalid_argument, 400 digits ->
+// std::out_of_range) escaped find_stereo_gt_pairs as a non-InputError exception.
+TEST(FuzzFindings, DatasetsXmlScaleThatIsNotANumberIsAnInputError) {
+  for (const std::string& scale :
+       std::vector<std::string>{".", "1.2.3", std::string(400, '9'), "0"}) {
+    ScratchDir dir;
+    std::filesystem::create_directories(dir.path() / "scene1");
+    for (const char* f : {"im2.png", "im6.png", "disp2.png"})
+      std::ofstream(dir.path() / "scene1" / f);
+    std::ofstream(dir.path() / "datasets.xml")
+        << "<datasets>\n\tscene1 \"" << scale << "\" \"0\"\n";
+    const std::string message = input_error_of([&] { find_stereo_gt_pairs(dir.path(), 0.0); });
+    EXPECT_TRUE(contains(message, "datasets.xml:2: scale")) << scale << ": " << message;
+  }
+  // Valid scales and lines that are not scale lines still work.
+  ScratchDir dir;
+  std::filesystem::create_directories(dir.path() / "scene1");
+  for (const char* f : {"im2.png", "im6.png", "disp2.png"})
+    std::ofstream(dir.path() / "scene1" / f);
+  std::ofstream(dir.path() / "datasets.xml")
+      << "<?xml version=\"1.0\"?>\n<!-- name, scaleFactor, unknValue -->\n\tscene1 \"4\" \"0\"\n";
+  const auto pairs = find_stereo_gt_pairs(dir.path(), 0.0);
+  ASSERT_EQ(pairs.size(), 1u);
+  EXPECT_EQ(pairs[0].scale, 4.0);
+}
+
+// fuzz_kitti_times: "2011-09-31 00:074327100:00" overflowed int (minutes * 60) in the date
+// arithmetic (UBSan: signed integer overflow); fields out of range are not a timestamp.
+TEST(FuzzFindings, KittiTimestampWithAFieldOutOfRangeIsAnInputError) {
+  for (const std::string line :
+       {"2011-09-31 00:074327100:00", "2011-13-01 00:00:00", "2011-00-01 00:00:00",
+        "2011-09-26 24:00:00", "2147483647-09-26 13:02:25.9", "-2147483648-01-01 00:00:00",
+        "2011-09-2147483647 13:02:25.9", "2011-09-26 13:60:00"}) {
+    ScratchDir dir;
+    std::ofstream(dir.path() / "timestamps.txt") << "2011-09-26 13:02:25.964389445\n"
+                                                 << line << "\n";
+    const std::string message =
+        input_error_of([&] { read_kitti_times(dir.path() / "timestamps.txt"); });
+    EXPECT_TRUE(contains(message, "timestamps.txt:2: not a timestamp")) << line << ": " << message;
+  }
+  ScratchDir dir;
+  std::ofstream(dir.path() / "timestamps.txt")
+      << "2011-09-26 13:02:25.964389445\n\n2011-09-26 13:02:26.064389445\n";
+  const auto times = read_kitti_times(dir.path() / "timestamps.txt");
+  ASSERT_EQ(times.size(), 2u);
+  EXPECT_NEAR(times[1] - times[0], 0.1, 1e-9);
+}
+
+// Found reading the code behind fuzz_euroc_csv: open_euroc subtracts timestamps, which overflowed
+// for a negative stamp next to a large one; strtoll's ERANGE was taken as a stamp.
+TEST(FuzzFindings, EurocNegativeOrOverflowingTimestampIsAnInputError) {
+  for (const std::string stamp : {"-9223372036854775807", "-5", "99999999999999999999"}) {
+    ScratchDir dir;
+    std::filesystem::create_directories(dir.path() / "cam0");
+    std::ofstream(dir.path() / "cam0" / "data.csv") << "#timestamp [ns],filename\n100,a.png\n"
+                                                    << stamp << ",b.png\n";
+    const std::string message = input_error_of([&] { read_euroc_csv(dir.path() / "cam0"); });
+    EXPECT_TRUE(contains(message, "data.csv:3: timestamp '" + stamp + "'")) << message;
+  }
+}
+
+}  // namespace
+}  // namespace sg::io
