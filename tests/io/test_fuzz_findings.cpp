@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "io_test_util.hpp"
+#include "sg/io/calibration.hpp"
 #include "sg/io/sources.hpp"
 #include "sg/io/stereo_gt.hpp"
 
@@ -94,6 +95,18 @@ TEST(FuzzFindings, EurocNegativeOrOverflowingTimestampIsAnInputError) {
     const std::string message = input_error_of([&] { read_euroc_csv(dir.path() / "cam0"); });
     EXPECT_TRUE(contains(message, "data.csv:3: timestamp '" + stamp + "'")) << message;
   }
+}
+
+// fuzz_calibration: a key like ":dtd" inside a matrix made OpenCV 4.6's YAML reader throw
+// std::length_error out of cv::FileStorage::open, past read_opencv_calibration.
+TEST(FuzzFindings, OpenCvCalibrationThatOpenCvCannotParseIsAnInputError) {
+  ScratchDir dir;
+  std::ofstream(dir.path() / "calib.yml")
+      << "%YAML:1.0\n---\nM1: !!opencv-matrix\n  rows: 3\n  :dtd \n  data: [1]\n";
+  EXPECT_TRUE(contains(input_error_of([&] { read_opencv_calibration(dir.path() / "calib.yml"); }),
+                       "cannot parse calibration file"));
+  EXPECT_TRUE(contains(input_error_of([&] { read_calibration(dir.path() / "calib.yml"); }),
+                       "cannot parse calibration file"));
 }
 
 }  // namespace
