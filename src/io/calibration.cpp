@@ -89,6 +89,12 @@ cv::FileStorage open_storage(const fs::path& path) {
     throw core::InputError("cannot parse calibration file " + path.string() +
                            " (not OpenCV YAML/XML)");
   }
+  // Fields are looked up by name, which OpenCV asserts on (cv::Exception) unless the top level is
+  // a mapping (found by fuzz_calibration: a file whose top level is a list).
+  if (!file.root().isMap()) {
+    throw core::InputError("cannot parse calibration file " + path.string() +
+                           ": the top level is not a mapping of fields (M1, D1, ...)");
+  }
   return file;
 }
 
@@ -279,8 +285,12 @@ StereoCalibration read_opencv_calibration(const fs::path& path) {
     *m = fs_matrix(file, name, path, false);
   }
   int width = 0, height = 0;
-  if (!file["image_width"].empty()) file["image_width"] >> width;
-  if (!file["image_height"].empty()) file["image_height"] >> height;
+  try {
+    if (!file["image_width"].empty()) file["image_width"] >> width;
+    if (!file["image_height"].empty()) file["image_height"] >> height;
+  } catch (const cv::Exception&) {
+    throw core::InputError(path.string() + ": image_width and image_height must be integers");
+  }
   c.image_size = cv::Size(width, height);
   core::throw_if_invalid(validate(c), "invalid calibration " + path.string());
   return c;

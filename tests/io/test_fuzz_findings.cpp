@@ -109,5 +109,14 @@ TEST(FuzzFindings, OpenCvCalibrationThatOpenCvCannotParseIsAnInputError) {
                        "cannot parse calibration file"));
 }
 
+// fuzz_calibration: a file whose top level is a list made cv::FileStorage::operator[] assert
+// (cv::Exception "isMap()") when the fields were looked up.
+TEST(FuzzFindings, OpenCvCalibrationWhoseTopLevelIsNotAMappingIsAnInputError) {
+  ScratchDir dir;
+  std::ofstream(dir.path() / "calib.yml") << "%YAML:1.0\n---\n- 1\n";
+  EXPECT_TRUE(contains(input_error_of([&] { read_calibration(dir.path() / "calib.yml"); }),
+                       "the top level is not a mapping"));
+}
+
 }  // namespace
 }  // namespace sg::io
