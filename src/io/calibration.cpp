@@ -51,6 +51,27 @@ void check_distortion(std::vector<std::string>& out, const char* name, const cv:
   }
 }
 
+/// False when an opencv-matrix node states rows, cols or sizes that are not small non-negative
+/// integers: OpenCV allocates what they say before reading the data (found by fuzz_calibration:
+/// a garbled `rows:` made it allocate 16 GiB). Calibration matrices are at most 4x4 or 1x14.
+bool small_matrix_node(const cv::FileNode& node) {
+  if (!node.isMap()) return true;
+  auto small = [](const cv::FileNode& n) {
+    return n.isInt() && static_cast<int>(n) >= 0 && static_cast<int>(n) <= 64;
+  };
+  for (const char* key : {"rows", "cols"}) {
+    const cv::FileNode n = node[key];
+    if (!n.empty() && !small(n)) return false;
+  }
+  const cv::FileNode sizes = node["sizes"];
+  if (!sizes.empty()) {
+    if (!sizes.isSeq() || sizes.size() > 3) return false;
+    for (const cv::FileNode& n : sizes)
+      if (!small(n)) return false;
+  }
+  return true;
+}
+
 /// A field of a FileStorage file as a CV_64F matrix; InputError when missing or not a matrix.
 cv::Mat fs_matrix(const cv::FileStorage& file, const char* name, const fs::path& path,
                   bool required) {
@@ -58,6 +79,10 @@ cv::Mat fs_matrix(const cv::FileStorage& file, const char* name, const fs::path&
   if (node.empty() || node.isNone()) {
     if (!required) return {};
     throw core::InputError(path.string() + ": missing field '" + name + "'");
+  }
+  if (!small_matrix_node(node)) {
+    throw core::InputError(path.string() + ": field '" + name +
+                           "' states rows/cols that are not integers from 0 to 64");
   }
   cv::Mat m;
   try {

@@ -9,6 +9,7 @@
 
 #include "io_test_util.hpp"
 #include "sg/io/calibration.hpp"
+#include "sg/io/config.hpp"
 #include "sg/io/sources.hpp"
 #include "sg/io/stereo_gt.hpp"
 
@@ -116,6 +117,32 @@ TEST(FuzzFindings, OpenCvCalibrationWhoseTopLevelIsNotAMappingIsAnInputError) {
   std::ofstream(dir.path() / "calib.yml") << "%YAML:1.0\n---\n- 1\n";
   EXPECT_TRUE(contains(input_error_of([&] { read_calibration(dir.path() / "calib.yml"); }),
                        "the top level is not a mapping"));
+}
+
+// fuzz_calibration: a garbled `rows:` of a matrix made OpenCV allocate 16 GiB for it before
+// reading its data (libFuzzer: out-of-memory, malloc(17179869248)).
+TEST(FuzzFindings, OpenCvCalibrationMatrixWithHugeRowsIsRefusedBeforeAllocating) {
+  for (const std::string rows : {"2147483647", "-3", "65", "\"3\""}) {
+    ScratchDir dir;
+    std::ofstream(dir.path() / "calib.yml")
+        << "%YAML:1.0\n---\nM1: !!opencv-matrix\n  rows: " << rows
+        << "\n  cols: 1\n  dt: d\n  data: [1, 2, 3]\n";
+    EXPECT_TRUE(contains(input_error_of([&] { read_calibration(dir.path() / "calib.yml"); }),
+                         "field 'M1' states rows/cols that are not integers from 0 to 64"))
+        << rows;
+  }
+}
+
+// fuzz_config: a complex YAML key ("? ...") in a section made yaml-cpp's bad conversion escape
+// apply_config_file.
+TEST(FuzzFindings, ConfigKeyThatIsNotANameIsAnInputError) {
+  ScratchDir dir;
+  std::ofstream(dir.path() / "c.yaml") << "stereo:\n?  nu block_size: 4\n";
+  core::DetectorParams params;
+  RunSettings settings;
+  EXPECT_TRUE(
+      contains(input_error_of([&] { apply_config_file(dir.path() / "c.yaml", params, settings); }),
+               "stereo has a key that is not a name"));
 }
 
 }  // namespace
