@@ -133,8 +133,8 @@ TEST(FuzzFindings, OpenCvCalibrationMatrixWithHugeRowsIsRefusedBeforeAllocating)
   }
 }
 
-// fuzz_config: a complex YAML key ("? ...") in a section made yaml-cpp's bad conversion escape
-// apply_config_file.
+// fuzz_config: a complex YAML key ("? ...") in the config (or a section of it) made yaml-cpp's bad
+// conversion escape apply_config_file.
 TEST(FuzzFindings, ConfigKeyThatIsNotANameIsAnInputError) {
   ScratchDir dir;
   std::ofstream(dir.path() / "c.yaml") << "stereo:\n?  nu block_size: 4\n";
@@ -142,7 +142,7 @@ TEST(FuzzFindings, ConfigKeyThatIsNotANameIsAnInputError) {
   RunSettings settings;
   EXPECT_TRUE(
       contains(input_error_of([&] { apply_config_file(dir.path() / "c.yaml", params, settings); }),
-               "stereo has a key that is not a name"));
+               "config has a key that is not a name"));
 }
 
 }  // namespace
