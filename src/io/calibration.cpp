@@ -417,7 +417,10 @@ std::shared_ptr<const Rectification> make_rectification(const StereoCalibration&
                                                         cv::Size image_size,
                                                         const std::string& where) {
   core::throw_if_invalid(validate(calib), "invalid calibration " + where);
-  if (calib.image_size.area() > 0 && calib.image_size != image_size) {
+  // Not image_size.area(): width * height overflows int for a stated size like 2147483647 x 48
+  // (found by fuzz_calibration, UBSan).
+  const bool size_stated = calib.image_size.width > 0 && calib.image_size.height > 0;
+  if (size_stated && calib.image_size != image_size) {
     throw core::InputError("calibration " + where + " is for " +
                            detail::size_text(calib.image_size) + " images, the frames are " +
                            detail::size_text(image_size));

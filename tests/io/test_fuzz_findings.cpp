@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration_text.hpp"
 #include "io_test_util.hpp"
 #include "sg/io/calibration.hpp"
 #include "sg/io/config.hpp"
@@ -143,6 +144,21 @@ TEST(FuzzFindings, ConfigKeyThatIsNotANameIsAnInputError) {
   EXPECT_TRUE(
       contains(input_error_of([&] { apply_config_file(dir.path() / "c.yaml", params, settings); }),
                "config has a key that is not a name"));
+}
+
+// fuzz_calibration: image_width 2147483647 overflowed int in cv::Size::area() when
+// make_rectification compared the stated size with the frames' (UBSan).
+TEST(FuzzFindings, CalibrationForHugeImagesIsASizeMismatchNotAnOverflow) {
+  ScratchDir dir;
+  testing_util::write_calibration_text(dir.path() / "calib.yml",
+                                       "250, 0, 160, 0, 250, 120, 0, 0, 1");
+  std::ofstream(dir.path() / "calib.yml", std::ios::app)
+      << "image_width: 2147483647\nimage_height: 48\n";
+  const StereoCalibration calib = read_opencv_calibration(dir.path() / "calib.yml");
+  EXPECT_TRUE(contains(input_error_of([&] {
+                         make_rectification(calib, {64, 48}, "calib.yml");
+                       }),
+                       "is for 2147483647x48 images, the frames are 64x48"));
 }
 
 }  // namespace
