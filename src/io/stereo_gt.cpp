@@ -100,6 +100,22 @@ void pairs_in(const fs::path& dir, double scale, std::vector<StereoGtPair>& out)
   }
 }
 
+/// cv::imread picks its decoder by content, not by name: a 22-byte OpenEXR header named
+/// disp2.png kept it busy for seconds (found by fuzz_stereo_gt). GT images are PNG (or PGM, as
+/// some Middlebury 2001 files are); anything else is refused before decoding.
+void check_gt_image_signature(const fs::path& path) {
+  static constexpr unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  unsigned char head[sizeof kPng] = {};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError("cannot read GT disparity " + path.string());
+  in.read(reinterpret_cast<char*>(head), sizeof head);
+  const bool png = in.gcount() == sizeof head && std::memcmp(head, kPng, sizeof head) == 0;
+  const bool pgm = in.gcount() >= 2 && head[0] == 'P' && (head[1] == '2' || head[1] == '5');
+  if (!png && !pgm) {
+    throw core::InputError(path.string() + ": GT disparity is not a PNG or PGM image");
+  }
+}
+
 }  // namespace
 
 cv::Mat read_pfm(const fs::path& path) {
@@ -160,6 +176,7 @@ void write_pfm(const fs::path& path, const cv::Mat& disparity) {
 
 cv::Mat read_middlebury_png(const fs::path& path, double scale) {
   if (!(scale > 0)) throw core::InputError("gt_scale=" + std::to_string(scale) + ": must be > 0");
+  check_gt_image_signature(path);
   cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   if (raw.empty()) throw core::InputError("cannot read GT disparity " + path.string());
   if (raw.depth() != CV_8U)
@@ -172,6 +189,7 @@ cv::Mat read_middlebury_png(const fs::path& path, double scale) {
 
 cv::Mat read_stereo_gt(const fs::path& path, double scale) {
   if (path.extension() == ".pfm") return read_pfm(path);
+  check_gt_image_signature(path);
   cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   if (raw.empty()) throw core::InputError("cannot read GT disparity " + path.string());
   if (raw.depth() == CV_16U) return read_disparity_png(path);

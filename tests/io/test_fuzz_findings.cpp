@@ -161,5 +161,21 @@ TEST(FuzzFindings, CalibrationForHugeImagesIsASizeMismatchNotAnOverflow) {
                        "is for 2147483647x48 images, the frames are 64x48"));
 }
 
+// fuzz_stereo_gt: a 22-byte OpenEXR header named .png kept cv::imread busy for seconds (libFuzzer
+// slow unit); read_stereo_gt now refuses what is not PNG or PGM before decoding.
+TEST(FuzzFindings, GtImageThatIsNotPngOrPgmIsRefusedBeforeDecoding) {
+  ScratchDir dir;
+  const unsigned char exr[] = {0x76, 0x2f, 0x31, 0x01, 0x02, 0x00, 0x00, 0x00, 0xd5, 0x00, 0x00,
+                               0x00, 0x0c, 0x6a, 0x50, 0x20, 0x20, 0x0d, 0x0a, 0x87, 0x0a};
+  std::ofstream(dir.path() / "disp.png", std::ios::binary)
+      .write(reinterpret_cast<const char*>(exr), sizeof exr);
+  for (const double scale : {0.0, 4.0}) {
+    EXPECT_TRUE(contains(input_error_of([&] { read_stereo_gt(dir.path() / "disp.png", scale); }),
+                         "GT disparity is not a PNG or PGM image"));
+  }
+  EXPECT_TRUE(contains(input_error_of([&] { read_middlebury_png(dir.path() / "disp.png", 4.0); }),
+                       "GT disparity is not a PNG or PGM image"));
+}
+
 }  // namespace
 }  // namespace sg::io
