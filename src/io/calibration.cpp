@@ -51,6 +51,27 @@ void check_distortion(std::vector<std::string>& out, const char* name, const cv:
   }
 }
 
+/// False when an opencv-matrix node states rows, cols or sizes that are not small non-negative
+/// integers: OpenCV allocates what they say before reading the data (found by fuzz_calibration:
+/// a garbled `rows:` made it allocate 16 GiB). Calibration matrices are at most 4x4 or 1x14.
+bool small_matrix_node(const cv::FileNode& node) {
+  if (!node.isMap()) return true;
+  auto small = [](const cv::FileNode& n) {
+    return n.isInt() && static_cast<int>(n) >= 0 && static_cast<int>(n) <= 64;
+  };
+  for (const char* key : {"rows", "cols"}) {
+    const cv::FileNode n = node[key];
+    if (!n.empty() && !small(n)) return false;
+  }
+  const cv::FileNode sizes = node["sizes"];
+  if (!sizes.empty()) {
+    if (!sizes.isSeq() || sizes.size() > 3) return false;
+    for (const cv::FileNode& n : sizes)
+      if (!small(n)) return false;
+  }
+  return true;
+}
+
 /// A field of a FileStorage file as a CV_64F matrix; InputError when missing or not a matrix.
 cv::Mat fs_matrix(const cv::FileStorage& file, const char* name, const fs::path& path,
                   bool required) {
@@ -59,10 +80,14 @@ cv::Mat fs_matrix(const cv::FileStorage& file, const char* name, const fs::path&
     if (!required) return {};
     throw core::InputError(path.string() + ": missing field '" + name + "'");
   }
+  if (!small_matrix_node(node)) {
+    throw core::InputError(path.string() + ": field '" + name +
+                           "' states rows/cols that are not integers from 0 to 64");
+  }
   cv::Mat m;
   try {
     node >> m;
-  } catch (const cv::Exception&) {
+  } catch (const std::exception&) {  // cv::Exception, or a standard one from OpenCV's reader
     m.release();
   }
   if (m.empty()) throw core::InputError(path.string() + ": field '" + name + "' is not a matrix");
@@ -79,13 +104,21 @@ cv::FileStorage open_storage(const fs::path& path) {
   cv::FileStorage file;
   try {
     file.open(path.string(), cv::FileStorage::READ);
-  } catch (const cv::Exception&) {
+  } catch (const std::exception&) {
+    // cv::Exception, and std::length_error that OpenCV 4.6's YAML reader lets out for a key
+    // like ":dtd" in a matrix (found by fuzz_calibration).
     throw core::InputError("cannot parse calibration file " + path.string() +
                            " (not OpenCV YAML/XML)");
   }
   if (!file.isOpened()) {
     throw core::InputError("cannot parse calibration file " + path.string() +
                            " (not OpenCV YAML/XML)");
+  }
+  // Fields are looked up by name, which OpenCV asserts on (cv::Exception) unless the top level is
+  // a mapping (found by fuzz_calibration: a file whose top level is a list).
+  if (!file.root().isMap()) {
+    throw core::InputError("cannot parse calibration file " + path.string() +
+                           ": the top level is not a mapping of fields (M1, D1, ...)");
   }
   return file;
 }
@@ -277,8 +310,12 @@ StereoCalibration read_opencv_calibration(const fs::path& path) {
     *m = fs_matrix(file, name, path, false);
   }
   int width = 0, height = 0;
-  if (!file["image_width"].empty()) file["image_width"] >> width;
-  if (!file["image_height"].empty()) file["image_height"] >> height;
+  try {
+    if (!file["image_width"].empty()) file["image_width"] >> width;
+    if (!file["image_height"].empty()) file["image_height"] >> height;
+  } catch (const cv::Exception&) {
+    throw core::InputError(path.string() + ": image_width and image_height must be integers");
+  }
   c.image_size = cv::Size(width, height);
   core::throw_if_invalid(validate(c), "invalid calibration " + path.string());
   return c;
@@ -380,7 +417,10 @@ std::shared_ptr<const Rectification> make_rectification(const StereoCalibration&
                                                         cv::Size image_size,
                                                         const std::string& where) {
   core::throw_if_invalid(validate(calib), "invalid calibration " + where);
-  if (calib.image_size.area() > 0 && calib.image_size != image_size) {
+  // Not image_size.area(): width * height overflows int for a stated size like 2147483647 x 48
+  // (found by fuzz_calibration, UBSan).
+  const bool size_stated = calib.image_size.width > 0 && calib.image_size.height > 0;
+  if (size_stated && calib.image_size != image_size) {
     throw core::InputError("calibration " + where + " is for " +
                            detail::size_text(calib.image_size) + " images, the frames are " +
                            detail::size_text(image_size));

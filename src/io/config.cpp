@@ -47,6 +47,8 @@ class Section {
   void done() const {
     if (!node_) return;
     for (const auto& kv : node_) {
+      // A complex key ("? [a, b]") has no name (found by fuzz_config: YAML bad conversion).
+      if (!kv.first.IsScalar()) fail(where_, "has a key that is not a name");
       const std::string key = kv.first.as<std::string>();
       if (!known_.count(key)) fail(where_ + "." + key, "is not a known setting");
     }

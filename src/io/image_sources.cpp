@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -32,7 +33,11 @@ bool parse_kitti_time(const std::string& text, std::int64_t& seconds, double& fr
   int y = 0, mo = 0, d = 0, h = 0, mi = 0;
   double s = 0;
   if (std::sscanf(text.c_str(), "%d-%d-%d %d:%d:%lf", &y, &mo, &d, &h, &mi, &s) != 6) return false;
-  if (!std::isfinite(s) || s < 0 || s >= 61) return false;
+  // Fields out of range are not a timestamp (and would overflow the arithmetic below).
+  if (y < 1 || y > 9999 || mo < 1 || mo > 12 || d < 1 || d > 31 || h < 0 || h > 23 || mi < 0 ||
+      mi > 59 || !std::isfinite(s) || s < 0 || s >= 61) {
+    return false;
+  }
   // Days from the civil date (H. Hinnant's algorithm).
   y -= mo <= 2;
   const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
@@ -45,6 +50,8 @@ bool parse_kitti_time(const std::string& text, std::int64_t& seconds, double& fr
   fraction = s - whole;
   return true;
 }
+
+}  // namespace
 
 std::vector<double> read_kitti_times(const fs::path& path) {
   std::ifstream in(path);
@@ -66,7 +73,6 @@ std::vector<double> read_kitti_times(const fs::path& path) {
   return times;
 }
 
-/// cam<i>/data.csv of EuRoC: timestamp (ns) -> image file.
 std::map<std::int64_t, fs::path> read_euroc_csv(const fs::path& cam_dir) {
   const fs::path csv = cam_dir / "data.csv";
   std::ifstream in(csv);
@@ -80,10 +86,16 @@ std::map<std::int64_t, fs::path> read_euroc_csv(const fs::path& cam_dir) {
     const size_t comma = line.find(',');
     long long stamp = 0;
     char* end = nullptr;
+    errno = 0;
     if (comma != std::string::npos) stamp = std::strtoll(line.c_str(), &end, 10);
     if (comma == std::string::npos || end != line.c_str() + comma) {
       throw core::InputError(csv.string() + ":" + std::to_string(line_no) +
                              ": expected 'timestamp_ns,file name'");
+    }
+    // Negative or overflowing stamps are not EuRoC's (ns since 1970); open_euroc subtracts them.
+    if (errno == ERANGE || stamp < 0) {
+      throw core::InputError(csv.string() + ":" + std::to_string(line_no) + ": timestamp '" +
+                             line.substr(0, comma) + "' is not a time in ns (0 .. 2^63 - 1)");
     }
     std::string name = line.substr(comma + 1);
     name.erase(
@@ -93,8 +105,6 @@ std::map<std::int64_t, fs::path> read_euroc_csv(const fs::path& cam_dir) {
   }
   return out;
 }
-
-}  // namespace
 
 size_t shorter_count(size_t left, size_t right, const std::string& left_name,
                      const std::string& right_name) {

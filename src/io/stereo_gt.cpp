@@ -6,7 +6,6 @@
 #include <fstream>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
-#include <regex>
 #include <sstream>
 
 #include "sg/core/error.hpp"
@@ -23,15 +22,39 @@ bool little_endian_host() {
   return b == 1;
 }
 
-/// Scales listed in an OpenCV datasets.xml (lines `name "scale" "unknown"`); empty if none.
+/// `"text"` -> text; false when `word` is not one quoted run of [0-9.].
+bool quoted_number_text(const std::string& word, std::string& text) {
+  if (word.size() < 3 || word.front() != '"' || word.back() != '"') return false;
+  text = word.substr(1, word.size() - 2);
+  return text.find_first_not_of("0123456789.") == std::string::npos;
+}
+
+/// Scales listed in an OpenCV datasets.xml (lines `name "scale" "unknown"`; other lines are
+/// ignored); empty if none. Throws InputError naming the file and line when a scale is not a
+/// finite number > 0 (e.g. "." or "1.2.3").
 std::map<std::string, double> read_dataset_scales(const fs::path& xml) {
   std::map<std::string, double> out;
   std::ifstream in(xml);
-  const std::regex line(R"(^\s*([A-Za-z0-9_\-]+)\s+\"([0-9.]+)\"\s+\"[0-9.]+\"\s*$)");
   std::string text;
-  std::smatch m;
-  while (std::getline(in, text))
-    if (std::regex_match(text, m, line)) out[m[1]] = std::stod(m[2]);
+  for (int line_no = 1; std::getline(in, text); ++line_no) {
+    std::istringstream words(text);
+    std::string name, scale_word, unknown_word, extra, scale_text, unknown_text;
+    if (!(words >> name >> scale_word >> unknown_word) || (words >> extra)) continue;
+    if (name.find_first_not_of(
+            "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") !=
+            std::string::npos ||
+        !quoted_number_text(scale_word, scale_text) ||
+        !quoted_number_text(unknown_word, unknown_text)) {
+      continue;
+    }
+    char* end = nullptr;
+    const double scale = std::strtod(scale_text.c_str(), &end);
+    if (end != scale_text.c_str() + scale_text.size() || !std::isfinite(scale) || !(scale > 0)) {
+      throw core::InputError(xml.string() + ":" + std::to_string(line_no) + ": scale \"" +
+                             scale_text + "\" of '" + name + "' is not a number > 0");
+    }
+    out[name] = scale;
+  }
   return out;
 }
 
@@ -77,6 +100,22 @@ void pairs_in(const fs::path& dir, double scale, std::vector<StereoGtPair>& out)
   }
 }
 
+/// cv::imread picks its decoder by content, not by name: a 22-byte OpenEXR header named
+/// disp2.png kept it busy for seconds (found by fuzz_stereo_gt). GT images are PNG (or PGM, as
+/// some Middlebury 2001 files are); anything else is refused before decoding.
+void check_gt_image_signature(const fs::path& path) {
+  static constexpr unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  unsigned char head[sizeof kPng] = {};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError("cannot read GT disparity " + path.string());
+  in.read(reinterpret_cast<char*>(head), sizeof head);
+  const bool png = in.gcount() == sizeof head && std::memcmp(head, kPng, sizeof head) == 0;
+  const bool pgm = in.gcount() >= 2 && head[0] == 'P' && (head[1] == '2' || head[1] == '5');
+  if (!png && !pgm) {
+    throw core::InputError(path.string() + ": GT disparity is not a PNG or PGM image");
+  }
+}
+
 }  // namespace
 
 cv::Mat read_pfm(const fs::path& path) {
@@ -91,6 +130,18 @@ cv::Mat read_pfm(const fs::path& path) {
     throw core::InputError(path.string() + ": not a one-channel PFM file (\"Pf\" header)");
   }
   in.get();  // the single whitespace byte after the scale
+  // The header alone must not make us allocate: 17 bytes can announce 65536 x 65536 floats.
+  const std::streamoff data_at = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff file_size = in.tellg();
+  in.seekg(data_at);
+  const std::streamoff needed = static_cast<std::streamoff>(width) * height * 4;
+  if (data_at < 0 || file_size - data_at < needed) {
+    throw core::InputError(path.string() + ": PFM file is truncated (" + std::to_string(width) +
+                           "x" + std::to_string(height) + " needs " + std::to_string(needed) +
+                           " bytes of data, the file holds " +
+                           std::to_string(std::max<std::streamoff>(0, file_size - data_at)) + ")");
+  }
   cv::Mat out(height, width, CV_32F);
   const bool swap = (scale < 0) != little_endian_host();
   std::vector<unsigned char> row(static_cast<size_t>(width) * 4);
@@ -125,6 +176,7 @@ void write_pfm(const fs::path& path, const cv::Mat& disparity) {
 
 cv::Mat read_middlebury_png(const fs::path& path, double scale) {
   if (!(scale > 0)) throw core::InputError("gt_scale=" + std::to_string(scale) + ": must be > 0");
+  check_gt_image_signature(path);
   cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   if (raw.empty()) throw core::InputError("cannot read GT disparity " + path.string());
   if (raw.depth() != CV_8U)
@@ -137,6 +189,7 @@ cv::Mat read_middlebury_png(const fs::path& path, double scale) {
 
 cv::Mat read_stereo_gt(const fs::path& path, double scale) {
   if (path.extension() == ".pfm") return read_pfm(path);
+  check_gt_image_signature(path);
   cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   if (raw.empty()) throw core::InputError("cannot read GT disparity " + path.string());
   if (raw.depth() == CV_16U) return read_disparity_png(path);

@@ -16,6 +16,12 @@ namespace sg::fuzz {
 std::filesystem::path write_input(const std::uint8_t* data, std::size_t size,
                                   const std::string& suffix);
 
+/// Writes `size` bytes to `name` (a relative path, folders created) inside a folder of this
+/// process and returns the file's path: for readers that take a folder or look for files next to
+/// the one they read. The same folder is reused by every call.
+std::filesystem::path write_named_input(const std::uint8_t* data, std::size_t size,
+                                        const std::filesystem::path& name);
+
 /// Runs `parse`; core::InputError is the expected answer to a bad file and is swallowed. Any
 /// other exception escapes to libFuzzer and counts as a finding: the CLI would report it as an
 /// internal error (exit status 1) instead of a clear message about the file.

@@ -32,14 +32,16 @@ inline long resident_kib() {
 /// sharing the clip's pixels (no copy, no rendering).
 class LoopSource : public core::FrameSource {
  public:
-  LoopSource(const std::vector<core::StereoFrame>& clip, const core::Camera& camera, int total)
-      : clip_(clip), camera_(camera), total_(total) {}
+  LoopSource(const std::vector<core::StereoFrame>& clip, const core::Camera& camera, int total,
+             std::function<void(core::StereoFrame&)> tamper = {})
+      : clip_(clip), camera_(camera), total_(total), tamper_(std::move(tamper)) {}
   std::optional<core::StereoFrame> next() override {
     if (next_ >= total_) return std::nullopt;
     core::StereoFrame f = clip_[static_cast<std::size_t>(next_) % clip_.size()];
     f.index = next_;
     f.time_s = next_ / camera_.fps;
     ++next_;
+    if (tamper_) tamper_(f);
     return f;
   }
   const core::Camera& camera() const override { return camera_; }
@@ -50,6 +52,7 @@ class LoopSource : public core::FrameSource {
   const std::vector<core::StereoFrame>& clip_;
   core::Camera camera_;
   int total_;
+  std::function<void(core::StereoFrame&)> tamper_;
   int next_ = 0;
 };
 
@@ -61,6 +64,9 @@ struct Config {
   int warmup = 5000;        ///< frames before the memory baseline is taken
   int sample_every = 1000;  ///< frames between two memory samples
   RunOptions options;       ///< W 2, T 2, Stereo-Flow by default (see default_config)
+  /// Harness self-test only: alters each frame as the source hands it out (e.g. renumbers one, as
+  /// a source or pipeline that loses or repeats a frame would look to the sink).
+  std::function<void(core::StereoFrame&)> tamper;
 };
 
 /// The acceptance configuration, overridable by environment variables: SG_SOAK_FRAMES,
@@ -133,9 +139,8 @@ inline Result run_soak(const Config& c, const std::function<void()>& per_frame =
   o.params.signal.min_area_px = std::max(1, static_cast<int>(o.params.signal.min_area_px * area));
   o.params.signal.region_min_px =
       std::max(1, static_cast<int>(o.params.signal.region_min_px * area));
-  LoopSource source(clip, camera, c.frames);
+  LoopSource source(clip, camera, c.frames, c.tamper);
   Result r;
-  r.warmup_frames = c.warmup;
   r.warmup_frames = c.warmup;
   r.samples.emplace_back(0, resident_kib());
   r.summary = run(source, o, [&](const core::StereoFrame& f, const core::Detection& d) {
@@ -158,6 +163,25 @@ inline Result run_soak(const Config& c, const std::function<void()>& per_frame =
   r.frames_in = source.handed_out();
   r.dropped = r.summary.dropped;
   return r;
+}
+
+/// Why a soak run fails, one line per reason (empty: it passes): frames lost, duplicated or out of
+/// order, frames dropped, memory unreadable, or resident memory grown by more than
+/// `max_growth_mb` after the warm-up (Result::growth_kib). test_soak asserts it is empty;
+/// test_soak_harness checks that it is not for a run that leaks or renumbers a frame.
+inline std::vector<std::string> failures(const Config& c, const Result& r, double max_growth_mb) {
+  std::vector<std::string> out;
+  auto add = [&out](const std::string& what) { out.push_back(what); };
+  if (r.frames_in != c.frames) add("frames in " + std::to_string(r.frames_in));
+  if (r.frames_out != c.frames) add("frames out " + std::to_string(r.frames_out));
+  if (r.summary.frames != c.frames) add("summary frames " + std::to_string(r.summary.frames));
+  if (r.out_of_order != 0) add("out of order " + std::to_string(r.out_of_order));
+  if (r.dropped != 0) add("dropped " + std::to_string(r.dropped));
+  if (r.baseline_kib <= 0) add("/proc/self/statm unreadable");
+  if (r.growth_kib() / 1024.0 > max_growth_mb) {
+    add("memory grew by " + std::to_string(r.growth_kib() / 1024.0) + " MiB after the warm-up");
+  }
+  return out;
 }
 
 }  // namespace sg::pipeline::soak

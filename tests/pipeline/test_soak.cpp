@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 
 #include "soak.hpp"
 
@@ -42,18 +43,14 @@ TEST(Soak, LoopedScenarioKeepsMemoryFlatAndEveryFrameInOrder) {
               r.summary.wall_s, r.summary.throughput_fps, r.summary.latency_p50_ms,
               r.summary.latency_p99_ms, r.summary.latency_max_ms);
 
-  EXPECT_EQ(r.frames_in, c.frames);
-  EXPECT_EQ(r.frames_out, c.frames);
-  EXPECT_EQ(r.summary.frames, c.frames);
-  EXPECT_EQ(r.out_of_order, 0);
-  EXPECT_EQ(r.dropped, 0);
   // Guards that the labelling does real work. At 320x240 and above the looped approach fires; at
   // smaller sizes the box stays below the (scaled) minimum area, so only the count is printed.
   std::printf("soak: alarm frames %d\n", r.summary.alarm_frames);
-  if (c.width >= 320)
+  if (c.width >= 320) {
     EXPECT_GT(r.summary.alarm_frames, 0) << "the looped approach must keep firing";
-  ASSERT_GT(r.baseline_kib, 0) << "/proc/self/statm unreadable";
-  EXPECT_LE(r.growth_kib() / 1024.0, max_growth_mb);
+  }
+  // Lost, repeated or out-of-order frames, drops and memory growth (soak.hpp, failures()).
+  for (const std::string& why : failures(c, r, max_growth_mb)) ADD_FAILURE() << "soak: " << why;
 }
 
 }  // namespace

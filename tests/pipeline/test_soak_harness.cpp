@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "soak.hpp"
@@ -35,6 +36,7 @@ TEST(SoakHarness, CountsEveryFrameInOrder) {
   // Samples: at start, at the warm-up end, then every sample_every frames.
   EXPECT_EQ(r.samples.size(), 1u + c.frames / c.sample_every);
   EXPECT_GT(r.baseline_kib, 0);
+  EXPECT_TRUE(failures(c, r, 4.0).empty());
 }
 
 TEST(SoakHarness, SeesALeak) {
@@ -45,6 +47,33 @@ TEST(SoakHarness, SeesALeak) {
   const Result r =
       run_soak(c, [&] { leak.push_back(std::make_unique<std::vector<char>>(65536, 1)); });
   EXPECT_GT(r.growth_kib(), 8 * 1024);
+  const auto why = failures(c, r, 4.0);
+  ASSERT_EQ(why.size(), 1u);
+  EXPECT_NE(why[0].find("memory grew"), std::string::npos) << why[0];
+}
+
+/// A frame lost from the stream (numbers jump from 149 to 151) fails the soak: every later frame
+/// is out of order.
+TEST(SoakHarness, SeesALostFrame) {
+  Config c = short_config();
+  c.tamper = [](core::StereoFrame& f) {
+    if (f.index >= 150) ++f.index;
+  };
+  const Result r = run_soak(c);
+  EXPECT_EQ(r.frames_out, c.frames);
+  EXPECT_EQ(r.out_of_order, c.frames - 150);
+  const auto why = failures(c, r, 4.0);
+  ASSERT_EQ(why.size(), 1u);
+  EXPECT_NE(why[0].find("out of order"), std::string::npos) << why[0];
+}
+
+/// A repeated frame (frame 150 numbered 149) stops the run: the detector refuses it.
+TEST(SoakHarness, ARepeatedFrameStopsTheRun) {
+  Config c = short_config();
+  c.tamper = [](core::StereoFrame& f) {
+    if (f.index == 150) f.index = 149;
+  };
+  EXPECT_THROW(run_soak(c), std::exception);
 }
 
 }  // namespace

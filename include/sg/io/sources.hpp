@@ -6,7 +6,9 @@
 /// Every source here gives the same frames through next() as through next_pending() + load():
 /// next() is next_pending() followed by load().
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <opencv2/videoio.hpp>
 #include <string>
@@ -158,6 +160,17 @@ size_t shorter_count(size_t left, size_t right, const std::string& left_name,
 /// Frame rate from acquisition times: 1 / median interval, Hz; 0 when fewer than 2 times or the
 /// median is not positive.
 double fps_from_times(const std::vector<double>& times_s);
+
+/// KITTI raw timestamps.txt: one "YYYY-MM-DD hh:mm:ss.fffffffff" a line (blank lines skipped),
+/// as seconds since the whole second of the first line. Throws InputError naming the file and line
+/// when a line is not such a timestamp (a field out of range included: month 13, minute
+/// 74327100, ...).
+std::vector<double> read_kitti_times(const std::filesystem::path& path);
+
+/// EuRoC CAM_DIR/data.csv: "timestamp_ns,file name" lines ('#' comments and blank lines skipped)
+/// as timestamp -> CAM_DIR/data/<file name>. Throws InputError naming the file and line when a
+/// line is malformed or its timestamp is negative or out of range.
+std::map<std::int64_t, std::filesystem::path> read_euroc_csv(const std::filesystem::path& cam_dir);
 
 /// KITTI raw drive: DIR/image_00/data/*.png + image_01 (or image_02/03 when `color`),
 /// DIR/image_0X/timestamps.txt ("YYYY-MM-DD hh:mm:ss.fffffffff", optional: else `camera.fps`),

@@ -10,7 +10,8 @@ namespace sg::io {
 
 /// PFM (Middlebury 2014, SceneFlow): "Pf" header, width height, scale (< 0 little-endian), float32
 /// rows bottom to top. Returns CV_32F px in top-to-bottom order; infinities and values <= 0 become
-/// 0 (unknown). Throws core::InputError on a bad file.
+/// 0 (unknown). Throws core::InputError on a bad file, including one shorter than its header says
+/// (checked before allocating).
 cv::Mat read_pfm(const std::filesystem::path& path);
 /// Writes a CV_32F map as little-endian PFM (for tests and tools).
 void write_pfm(const std::filesystem::path& path, const cv::Mat& disparity);
@@ -38,7 +39,8 @@ struct StereoGtPair {
 /// * Middlebury 2014: im0.png, im1.png, disp0GT.pfm or disp0.pfm;
 /// * KITTI 2012/2015: image_0|image_2/NAME_10.png, image_1|image_3/NAME_10.png,
 ///   disp_noc|disp_noc_0/NAME_10.png (16-bit).
-/// Throws core::InputError when the folder does not exist or holds no pair.
+/// Throws core::InputError when the folder does not exist or holds no pair, or when a
+/// datasets.xml scale line has a scale that is not a number > 0.
 std::vector<StereoGtPair> find_stereo_gt_pairs(const std::filesystem::path& dir, double scale);
 
 }  // namespace sg::io

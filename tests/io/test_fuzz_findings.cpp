@@ -1,0 +1,181 @@
+// Regression tests for what the fuzz targets (tests/fuzz) found in the parsers of user input: each
+// input below once crashed a parser, made it allocate without bound or hit undefined behaviour;
+// now it is a core::InputError naming the file.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "calibration_text.hpp"
+#include "io_test_util.hpp"
+#include "sg/io/calibration.hpp"
+#include "sg/io/config.hpp"
+#include "sg/io/sources.hpp"
+#include "sg/io/stereo_gt.hpp"
+
+namespace sg::io {
+namespace {
+
+using testing_util::input_error_of;
+using testing_util::ScratchDir;
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// fuzz_pfm: a 17-byte header announcing 65536 x 65536 floats made read_pfm allocate 16 GiB
+// before finding the data missing (libFuzzer: out-of-memory).
+TEST(FuzzFindings, PfmHeaderLargerThanTheFileIsRefusedBeforeAllocating) {
+  ScratchDir dir;
+  std::ofstream(dir.path() / "big.pfm", std::ios::binary) << "Pf\n65536 65536\n-1\n";
+  const std::string message = input_error_of([&] { read_pfm(dir.path() / "big.pfm"); });
+  EXPECT_TRUE(contains(message, "truncated")) << message;
+  EXPECT_TRUE(contains(message, "needs 17179869184 bytes of data, the file holds 0")) << message;
+  std::ofstream(dir.path() / "short.pfm", std::ios::binary) << "Pf\n2 2\n-1\n"
+                                                            << std::string(15, 'x');
+  EXPECT_TRUE(contains(input_error_of([&] { read_pfm(dir.path() / "short.pfm"); }),
+                       "needs 16 bytes of data, the file holds 15"));
+}
+
+// fuzz_datasets_xml: a scale that std::stod refused ("." -> std::invalid_argument, 400 digits ->
+// std::out_of_range) escaped find_stereo_gt_pairs as a non-InputError exception.
+TEST(FuzzFindings, DatasetsXmlScaleThatIsNotANumberIsAnInputError) {
+  for (const std::string& scale :
+       std::vector<std::string>{".", "1.2.3", std::string(400, '9'), "0"}) {
+    ScratchDir dir;
+    std::filesystem::create_directories(dir.path() / "scene1");
+    for (const char* f : {"im2.png", "im6.png", "disp2.png"})
+      std::ofstream(dir.path() / "scene1" / f);
+    std::ofstream(dir.path() / "datasets.xml")
+        << "<datasets>\n\tscene1 \"" << scale << "\" \"0\"\n";
+    const std::string message = input_error_of([&] { find_stereo_gt_pairs(dir.path(), 0.0); });
+    EXPECT_TRUE(contains(message, "datasets.xml:2: scale")) << scale << ": " << message;
+  }
+  // Valid scales and lines that are not scale lines still work.
+  ScratchDir dir;
+  std::filesystem::create_directories(dir.path() / "scene1");
+  for (const char* f : {"im2.png", "im6.png", "disp2.png"})
+    std::ofstream(dir.path() / "scene1" / f);
+  std::ofstream(dir.path() / "datasets.xml")
+      << "<?xml version=\"1.0\"?>\n<!-- name, scaleFactor, unknValue -->\n\tscene1 \"4\" \"0\"\n";
+  const auto pairs = find_stereo_gt_pairs(dir.path(), 0.0);
+  ASSERT_EQ(pairs.size(), 1u);
+  EXPECT_EQ(pairs[0].scale, 4.0);
+}
+
+// fuzz_kitti_times: "2011-09-31 00:074327100:00" overflowed int (minutes * 60) in the date
+// arithmetic (UBSan: signed integer overflow); fields out of range are not a timestamp.
+TEST(FuzzFindings, KittiTimestampWithAFieldOutOfRangeIsAnInputError) {
+  for (const std::string line :
+       {"2011-09-31 00:074327100:00", "2011-13-01 00:00:00", "2011-00-01 00:00:00",
+        "2011-09-26 24:00:00", "2147483647-09-26 13:02:25.9", "-2147483648-01-01 00:00:00",
+        "2011-09-2147483647 13:02:25.9", "2011-09-26 13:60:00"}) {
+    ScratchDir dir;
+    std::ofstream(dir.path() / "timestamps.txt") << "2011-09-26 13:02:25.964389445\n"
+                                                 << line << "\n";
+    const std::string message =
+        input_error_of([&] { read_kitti_times(dir.path() / "timestamps.txt"); });
+    EXPECT_TRUE(contains(message, "timestamps.txt:2: not a timestamp")) << line << ": " << message;
+  }
+  ScratchDir dir;
+  std::ofstream(dir.path() / "timestamps.txt")
+      << "2011-09-26 13:02:25.964389445\n\n2011-09-26 13:02:26.064389445\n";
+  const auto times = read_kitti_times(dir.path() / "timestamps.txt");
+  ASSERT_EQ(times.size(), 2u);
+  EXPECT_NEAR(times[1] - times[0], 0.1, 1e-9);
+}
+
+// Found reading the code behind fuzz_euroc_csv: open_euroc subtracts timestamps, which overflowed
+// for a negative stamp next to a large one; strtoll's ERANGE was taken as a stamp.
+TEST(FuzzFindings, EurocNegativeOrOverflowingTimestampIsAnInputError) {
+  for (const std::string stamp : {"-9223372036854775807", "-5", "99999999999999999999"}) {
+    ScratchDir dir;
+    std::filesystem::create_directories(dir.path() / "cam0");
+    std::ofstream(dir.path() / "cam0" / "data.csv") << "#timestamp [ns],filename\n100,a.png\n"
+                                                    << stamp << ",b.png\n";
+    const std::string message = input_error_of([&] { read_euroc_csv(dir.path() / "cam0"); });
+    EXPECT_TRUE(contains(message, "data.csv:3: timestamp '" + stamp + "'")) << message;
+  }
+}
+
+// fuzz_calibration: a key like ":dtd" inside a matrix made OpenCV 4.6's YAML reader throw
+// std::length_error out of cv::FileStorage::open, past read_opencv_calibration.
+TEST(FuzzFindings, OpenCvCalibrationThatOpenCvCannotParseIsAnInputError) {
+  ScratchDir dir;
+  std::ofstream(dir.path() / "calib.yml")
+      << "%YAML:1.0\n---\nM1: !!opencv-matrix\n  rows: 3\n  :dtd \n  data: [1]\n";
+  EXPECT_TRUE(contains(input_error_of([&] { read_opencv_calibration(dir.path() / "calib.yml"); }),
+                       "cannot parse calibration file"));
+  EXPECT_TRUE(contains(input_error_of([&] { read_calibration(dir.path() / "calib.yml"); }),
+                       "cannot parse calibration file"));
+}
+
+// fuzz_calibration: a file whose top level is a list made cv::FileStorage::operator[] assert
+// (cv::Exception "isMap()") when the fields were looked up.
+TEST(FuzzFindings, OpenCvCalibrationWhoseTopLevelIsNotAMappingIsAnInputError) {
+  ScratchDir dir;
+  std::ofstream(dir.path() / "calib.yml") << "%YAML:1.0\n---\n- 1\n";
+  EXPECT_TRUE(contains(input_error_of([&] { read_calibration(dir.path() / "calib.yml"); }),
+                       "the top level is not a mapping"));
+}
+
+// fuzz_calibration: a garbled `rows:` of a matrix made OpenCV allocate 16 GiB for it before
+// reading its data (libFuzzer: out-of-memory, malloc(17179869248)).
+TEST(FuzzFindings, OpenCvCalibrationMatrixWithHugeRowsIsRefusedBeforeAllocating) {
+  for (const std::string rows : {"2147483647", "-3", "65", "\"3\""}) {
+    ScratchDir dir;
+    std::ofstream(dir.path() / "calib.yml")
+        << "%YAML:1.0\n---\nM1: !!opencv-matrix\n  rows: " << rows
+        << "\n  cols: 1\n  dt: d\n  data: [1, 2, 3]\n";
+    EXPECT_TRUE(contains(input_error_of([&] { read_calibration(dir.path() / "calib.yml"); }),
+                         "field 'M1' states rows/cols that are not integers from 0 to 64"))
+        << rows;
+  }
+}
+
+// fuzz_config: a complex YAML key ("? ...") in the config (or a section of it) made yaml-cpp's bad
+// conversion escape apply_config_file.
+TEST(FuzzFindings, ConfigKeyThatIsNotANameIsAnInputError) {
+  ScratchDir dir;
+  std::ofstream(dir.path() / "c.yaml") << "stereo:\n?  nu block_size: 4\n";
+  core::DetectorParams params;
+  RunSettings settings;
+  EXPECT_TRUE(
+      contains(input_error_of([&] { apply_config_file(dir.path() / "c.yaml", params, settings); }),
+               "config has a key that is not a name"));
+}
+
+// fuzz_calibration: image_width 2147483647 overflowed int in cv::Size::area() when
+// make_rectification compared the stated size with the frames' (UBSan).
+TEST(FuzzFindings, CalibrationForHugeImagesIsASizeMismatchNotAnOverflow) {
+  ScratchDir dir;
+  testing_util::write_calibration_text(dir.path() / "calib.yml",
+                                       "250, 0, 160, 0, 250, 120, 0, 0, 1");
+  std::ofstream(dir.path() / "calib.yml", std::ios::app)
+      << "image_width: 2147483647\nimage_height: 48\n";
+  const StereoCalibration calib = read_opencv_calibration(dir.path() / "calib.yml");
+  EXPECT_TRUE(contains(input_error_of([&] {
+                         make_rectification(calib, {64, 48}, "calib.yml");
+                       }),
+                       "is for 2147483647x48 images, the frames are 64x48"));
+}
+
+// fuzz_stereo_gt: a 22-byte OpenEXR header named .png kept cv::imread busy for seconds (libFuzzer
+// slow unit); read_stereo_gt now refuses what is not PNG or PGM before decoding.
+TEST(FuzzFindings, GtImageThatIsNotPngOrPgmIsRefusedBeforeDecoding) {
+  ScratchDir dir;
+  const unsigned char exr[] = {0x76, 0x2f, 0x31, 0x01, 0x02, 0x00, 0x00, 0x00, 0xd5, 0x00, 0x00,
+                               0x00, 0x0c, 0x6a, 0x50, 0x20, 0x20, 0x0d, 0x0a, 0x87, 0x0a};
+  std::ofstream(dir.path() / "disp.png", std::ios::binary)
+      .write(reinterpret_cast<const char*>(exr), sizeof exr);
+  for (const double scale : {0.0, 4.0}) {
+    EXPECT_TRUE(contains(input_error_of([&] { read_stereo_gt(dir.path() / "disp.png", scale); }),
+                         "GT disparity is not a PNG or PGM image"));
+  }
+  EXPECT_TRUE(contains(input_error_of([&] { read_middlebury_png(dir.path() / "disp.png", 4.0); }),
+                       "GT disparity is not a PNG or PGM image"));
+}
+
+}  // namespace
+}  // namespace sg::io
