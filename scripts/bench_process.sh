@@ -73,7 +73,7 @@ for ((r = 0; r < runs; ++r)); do
       exit 1
     fi
     cat "$log.one" >>"$log"
-    if [[ $r == 0 ]]; then echo "  $name: $(grep -E 'frames|alarm' "$log.out" | head -2 | tr '\n' ' ')"; fi
+    if [[ $r == 0 ]]; then echo "  $name: $(grep -E "alarm|frames processed" "$log.out" | head -3 | tr '\n' ' ')"; fi
   done
 done
 rm -f "$log.one" "$log.out"
