@@ -9,6 +9,8 @@
 #
 #   scripts/bench_process.sh DIR [RUNS]       (RUNS default 7)
 #   BUILD=build/release WORKERS=2 MODES="stereo stereo-flow" MATCHERS="bm fast" PLAIN_LABELLING=naive
+#   PLAIN_TUNED=1: run the plain loop with the malloc settings stereoguard sets for itself
+#   (freed maps stay on the heap, see src/apps/main.cpp), to separate that gain from the pipeline's
 #
 # A 752x480 folder like the one of issue 8 (135 frames of head-on):
 #   scripts/bench_process.sh --make-folder DIR
@@ -21,6 +23,10 @@ workers="${WORKERS:-2}"
 modes="${MODES:-stereo stereo-flow}"
 matchers="${MATCHERS:-bm fast}"
 plain_labelling="${PLAIN_LABELLING:-naive}"
+plain_env=""
+if [[ -n "${PLAIN_TUNED:-}" ]]; then
+  plain_env="env GLIBC_TUNABLES=glibc.malloc.mmap_threshold=33554432:glibc.malloc.trim_threshold=536870912"
+fi
 
 for exe in "$sg" "$plain"; do
   [[ -x "$exe" ]] || { echo "missing $exe: build first (cmake --build build/release)" >&2; exit 2; }
@@ -50,7 +56,7 @@ command -v python3 >/dev/null || { echo "needs python3" >&2; exit 2; }
 # Commands: name|command line. The first of each mode is its baseline.
 cmds=()
 for mode in $modes; do
-  cmds+=("$mode plain-loop|$plain --input $dir --mode $mode --labelling $plain_labelling")
+  cmds+=("$mode plain-loop|$plain_env $plain --input $dir --mode $mode --labelling $plain_labelling")
   for matcher in $matchers; do
     cmds+=("$mode run-W$workers-$matcher|$sg run --input $dir --mode $mode --workers $workers --matcher $matcher --quiet")
   done
