@@ -1,10 +1,18 @@
 #include "sg/par/metrics.hpp"
 
+#include <time.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
 namespace sg::par {
+
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
 
 void LatencyStats::add(double ms) {
   samples_.push_back(ms);

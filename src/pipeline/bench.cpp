@@ -1,12 +1,11 @@
 #include "sg/pipeline/bench.hpp"
 
-#include <opencv2/calib3d.hpp>
-#include <opencv2/video/tracking.hpp>
 #include <sstream>
 
 #include "sg/core/error.hpp"
 #include "sg/io/memory_source.hpp"
 #include "sg/par/metrics.hpp"
+#include "sg/pipeline/plain_loop.hpp"
 #include "sg/pipeline/runner.hpp"
 #include "sg/sim/renderer.hpp"
 #include "sg/vision/detector.hpp"
@@ -57,35 +56,21 @@ class OpenCvThreads {
   int saved_;
 };
 
-/// The loop a user would write with OpenCV: StereoBM, DIS, our labelling, one frame at a time.
+/// The loop a user would write with OpenCV (PlainLoop: StereoBM, DIS, our labelling, one frame at a
+/// time), timed per frame.
 /// `opencv_threads` = 1 makes it truly sequential (the reference of DESIGN 8); -1 leaves OpenCV's
 /// own parallel loops on (StereoBM splits each frame into stripes on all cores).
 Measured run_baseline(const std::vector<core::StereoFrame>& frames, const core::Camera& camera,
                       const core::DetectorParams& params, int opencv_threads) {
   const OpenCvThreads threads(opencv_threads);
-  cv::Ptr<cv::StereoBM> bm = cv::StereoBM::create(params.bm.num_disparities, params.bm.block_size);
-  bm->setPreFilterCap(params.bm.prefilter_cap);
-  bm->setTextureThreshold(params.bm.texture_threshold);
-  bm->setUniquenessRatio(params.bm.uniqueness_ratio);
-  bm->setSpeckleWindowSize(params.bm.speckle_window);
-  bm->setSpeckleRange(params.bm.speckle_range * 16);
-  bm->setDisp12MaxDiff(params.bm.lr_max_diff);
-  cv::Ptr<cv::DISOpticalFlow> dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_ULTRAFAST);
-  vision::Detector detector(params, camera);
+  PlainLoop loop(params, camera);
 
   Measured m;
   par::LatencyStats latency;
-  cv::Mat disp16;
   const par::TimePoint start = par::now();
   for (size_t i = 0; i < frames.size(); ++i) {
     const par::TimePoint t0 = par::now();
-    vision::FrameMaps maps;
-    bm->compute(frames[i].left, frames[i].right, disp16);
-    disp16.convertTo(maps.disparity, CV_32F, 1.0 / 16);
-    if (params.mode == core::Mode::kStereoFlow && i > 0) {
-      dis->calc(frames[i].left, frames[i - 1].left, maps.flow);
-    }
-    m.signals.push_back(detector.process(frames[i], maps).signal);
+    m.signals.push_back(loop.process(frames[i]).signal);
     latency.add(par::elapsed_ms(t0));
   }
   const double wall_s = par::elapsed_ms(start) / 1000.0;

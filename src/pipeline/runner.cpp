@@ -1,6 +1,7 @@
 #include "sg/pipeline/runner.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <iomanip>
 #include <memory>
@@ -65,6 +66,9 @@ struct FrameJob {
   par::TimePoint acquired;
   double sm_ms = 0.0, of_ms = 0.0;
   std::vector<double> label_ms;  ///< one per labelling tile
+  /// Labelling bands not yet finished; the last one concludes the job (LabelJob::conclude).
+  std::unique_ptr<std::atomic<int>> bands_left;
+  double conclude_ms = 0.0;
 };
 
 /// The emitter: reads frames (decoding is left to the farm), paces them like a camera and drops
@@ -178,7 +182,9 @@ par::TaskList make_tasks(FrameJob& job, const RunOptions& o) {
 }
 
 /// The relay (serial, in frame order): the detector records the frame's maps in its history and
-/// hands back the frame's labelling, which the farm runs in row bands (max(W, T) of them).
+/// hands back the frame's labelling, which the farm runs in row bands (max(W, T) of them); the
+/// band that finishes last concludes it (mask cleaning, connected components, obstacle
+/// statistics), so that the collector keeps only what needs the stream order.
 par::TaskList relay_tasks(FrameJob& job, vision::Detector& detector, const RunOptions& o) {
   // The previous frame is decoded (its own first task did it) and no longer needed here.
   job.previous.reset();
@@ -190,10 +196,11 @@ par::TaskList relay_tasks(FrameJob& job, vision::Detector& detector, const RunOp
   const int bands =
       job.label.tileable() ? par::tile_count(job.label.rows(), std::max(o.workers, o.tiles)) : 1;
   job.label_ms.assign(static_cast<size_t>(bands), 0.0);
+  job.bands_left = std::make_unique<std::atomic<int>>(bands);
   par::TaskList tasks;
   for (int b = 0; b < bands; ++b) {
     tasks.emplace_back([&job, b, bands] {
-      const par::Stopwatch watch;
+      par::Stopwatch watch;
       if (bands == 1) {
         job.label.run(cv::Range::all());
       } else {
@@ -201,6 +208,11 @@ par::TaskList relay_tasks(FrameJob& job, vision::Detector& detector, const RunOp
         job.label.run(cv::Range(r.begin, r.end));
       }
       job.label_ms[static_cast<size_t>(b)] = watch.elapsed_ms();
+      // acq_rel: the last band sees every other band's rows.
+      if (job.bands_left->fetch_sub(1, std::memory_order_acq_rel) != 1) return;
+      watch.restart();
+      job.label.conclude();
+      job.conclude_ms = watch.elapsed_ms();
     });
   }
   return tasks;
@@ -266,6 +278,7 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
 
   auto collect = [&](FrameJob&& job) {
     const par::Stopwatch watch;
+    const par::CpuStopwatch cpu_watch;
     const core::StereoFrame& frame = job.frame->get();
     core::Detection detection = detector.finish(frame, job.label);
     if (options.keep_maps) {
@@ -290,10 +303,14 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
     s.busy_sm_ms += job.sm_ms;
     s.busy_of_ms += job.of_ms;
     s.busy_label_ms += std::accumulate(job.label_ms.begin(), job.label_ms.end(), 0.0);
+    s.busy_conclude_ms += job.conclude_ms;
     sink(frame, detection);
     const double collector_ms = watch.elapsed_ms();
+    const double collector_cpu_ms = cpu_watch.elapsed_ms();
     s.busy_collector_ms += collector_ms;
     s.collector_max_ms = std::max(s.collector_max_ms, collector_ms);
+    s.busy_collector_cpu_ms += collector_cpu_ms;
+    s.collector_cpu_max_ms = std::max(s.collector_cpu_max_ms, collector_cpu_ms);
   };
 
   try {
@@ -350,8 +367,11 @@ nlohmann::json RunSummary::to_json() const {
             {"stereo_matching", busy_sm_ms},
             {"optical_flow", busy_of_ms},
             {"labelling", busy_label_ms},
+            {"obstacles", busy_conclude_ms},
             {"collector", busy_collector_ms}}},
           {"collector_max_ms", collector_max_ms},
+          {"collector_cpu_ms", busy_collector_cpu_ms},
+          {"collector_cpu_max_ms", collector_cpu_max_ms},
           {"config",
            {{"mode", mode},
             {"workers", workers},
@@ -381,6 +401,15 @@ std::string RunSummary::text() const {
     << ", W " << workers << ", T " << tiles << ", tokens " << tokens << ")\n";
   s << "latency ms        p50 " << latency_p50_ms << "  p95 " << latency_p95_ms << "  p99 "
     << latency_p99_ms << "  max " << latency_max_ms << "\n";
+  if (frames > 0) {
+    const double n = frames;
+    s << std::setprecision(2) << "busy ms / frame   decode " << busy_decode_ms / n << "  SM "
+      << busy_sm_ms / n << "  OF " << busy_of_ms / n << "  labelling " << busy_label_ms / n
+      << "  obstacles " << busy_conclude_ms / n << "  emitter " << busy_emitter_ms / n
+      << "  collector " << busy_collector_ms / n << " (max " << collector_max_ms << "; CPU "
+      << busy_collector_cpu_ms / n << ", max " << collector_cpu_max_ms << ")\n"
+      << std::setprecision(1);
+  }
   return s.str();
 }
 

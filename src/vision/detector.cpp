@@ -116,27 +116,34 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
   return job;
 }
 
+void LabelJob::conclude() {
+  if (concluded_) return;
+  const core::DetectorParams& p = *params_;
+  const core::SceneFlowParams& sf = p.scene_flow;
+  if (flow_mode_ && sf.grow_into_edges)
+    grow_danger_into_edges(disparity_, edges_, sf.edge_margin_px, sf.edge_step_px,
+                           p.signal.open_size, danger_, ttc_, velocity_);
+  if (flow_mode_ && sf.exclude_ground) {
+    const GroundPlane plane = fit_ground_plane(disparity_, *camera_, sf.ground);
+    cv::Mat ground;
+    mark_ground(disparity_, *camera_, plane, sf.ground.tolerance_m, ground);
+    danger_.setTo(0, ground);
+    ttc_.setTo(std::numeric_limits<float>::quiet_NaN(), ground);
+  }
+  obstacles_ = extract_obstacles(danger_, disparity_, ttc_, *camera_, p.signal, velocity_);
+  region_pixels_ = count_region_pixels(danger_, p.signal.region_columns);
+  concluded_ = true;
+}
+
 core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) {
   core::Detection det;
   det.frame = frame.index;
   det.time_s = frame.time_s;
-  const cv::Mat& disp = job.disparity_;
-  const core::SceneFlowParams& sf = params_.scene_flow;
-  if (job.flow_mode_ && sf.grow_into_edges)
-    grow_danger_into_edges(disp, job.edges_, sf.edge_margin_px, sf.edge_step_px,
-                           params_.signal.open_size, job.danger_, job.ttc_, job.velocity_);
-  if (job.flow_mode_ && params_.scene_flow.exclude_ground) {
-    const GroundPlane plane = fit_ground_plane(disp, camera_, params_.scene_flow.ground);
-    cv::Mat ground;
-    mark_ground(disp, camera_, plane, params_.scene_flow.ground.tolerance_m, ground);
-    job.danger_.setTo(0, ground);
-    job.ttc_.setTo(std::numeric_limits<float>::quiet_NaN(), ground);
-  }
+  job.conclude();
   det.danger = job.danger_;
-  det.obstacles =
-      extract_obstacles(det.danger, disp, job.ttc_, camera_, params_.signal, job.velocity_);
+  det.obstacles = std::move(job.obstacles_);
   tracker_.update(det.time_s, det.obstacles);
-  det.regions = hysteresis_.update(count_region_pixels(det.danger, params_.signal.region_columns));
+  det.regions = hysteresis_.update(job.region_pixels_);
   det.signal = std::any_of(det.regions.begin(), det.regions.end(),
                            [](const core::RegionSignal& r) { return r.fired; });
   det.severity =

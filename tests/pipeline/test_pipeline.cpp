@@ -9,6 +9,7 @@
 #include "sg/io/events.hpp"
 #include "sg/io/memory_source.hpp"
 #include "sg/pipeline/dropping_source.hpp"
+#include "sg/pipeline/plain_loop.hpp"
 #include "sg/pipeline/runner.hpp"
 #include "sg/sim/renderer.hpp"
 
@@ -106,6 +107,20 @@ INSTANTIATE_TEST_SUITE_P(Modes, EveryConfiguration,
                          [](const auto& info) {
                            return info.param == core::Mode::kStereo ? "Stereo" : "StereoFlow";
                          });
+
+TEST_P(EveryConfiguration, PlainLoopGivesThePipelineDetections) {
+  // The baseline of bench and bench_process.sh does the same work: StereoBM, DIS ultrafast and
+  // the detector, one frame at a time.
+  for (const Clip* clip : {&head_on(), &crossing()}) {
+    const RunOptions options = options_for(GetParam());
+    const std::vector<std::string> expected = detections(*clip, options);
+    PlainLoop loop(options.params, clip->camera);
+    std::vector<std::string> got;
+    for (const core::StereoFrame& f : clip->frames)
+      got.push_back(io::detection_to_json(loop.process(f), /*timing=*/false).dump());
+    EXPECT_EQ(got, expected);
+  }
+}
 
 TEST(Pipeline, HeadOnClipFiresAndCrossingClipIsAnApproachOnlyInStereoMode) {
   // Guards the test data: the identity test above must compare runs that do detect something.

@@ -35,6 +35,22 @@ class Stopwatch {
   TimePoint start_;
 };
 
+/// CPU time of the calling thread, ms (CLOCK_THREAD_CPUTIME_ID): unlike wall time it does not
+/// grow while the thread waits for a core, so a stage's cost can be read on a loaded machine.
+/// Work the thread hands to other threads (nested parallel loops) is not counted.
+double thread_cpu_ms();
+
+/// Measures the calling thread's CPU time from construction; read it on the same thread.
+class CpuStopwatch {
+ public:
+  CpuStopwatch() : start_(thread_cpu_ms()) {}
+  /// CPU milliseconds this thread spent since the start.
+  double elapsed_ms() const { return thread_cpu_ms() - start_; }
+
+ private:
+  double start_;
+};
+
 /// Latency samples in milliseconds with nearest-rank percentiles. Not thread-safe: fill it from one
 /// stage (e.g. the collector) or guard it.
 class LatencyStats {

@@ -57,12 +57,17 @@ struct RunSummary {
   double service_ms = 0.0;      ///< mean interval between consecutive detections, ms
   double latency_p50_ms = 0.0, latency_p95_ms = 0.0, latency_p99_ms = 0.0, latency_max_ms = 0.0;
   double latency_mean_ms = 0.0;
-  /// Busy time per stage summed over the run, ms: emitter (read and stamp; decoding runs on the
-  /// farm), decode (imread, gray conversion: farm), stereo matching, optical flow, labelling
-  /// (per-pixel danger, farm tasks after the relay), collector (obstacles, signals, sinks).
+  /// Busy time per stage summed over the run, ms (wall time inside the stage): emitter (read and
+  /// stamp; decoding runs on the farm), decode (imread, gray conversion: farm), stereo matching,
+  /// optical flow, labelling (per-pixel danger, farm tasks after the relay), obstacles (mask
+  /// cleaning, connected components, obstacle statistics: the last labelling task,
+  /// LabelJob::conclude), collector (tracking, signals, sinks).
   double busy_emitter_ms = 0.0, busy_decode_ms = 0.0, busy_sm_ms = 0.0, busy_of_ms = 0.0,
-         busy_label_ms = 0.0, busy_collector_ms = 0.0;
+         busy_label_ms = 0.0, busy_conclude_ms = 0.0, busy_collector_ms = 0.0;
   double collector_max_ms = 0.0;  ///< the collector's longest frame, ms
+  /// The collector's thread CPU time, summed over the run and its longest frame, ms: on a loaded
+  /// machine wall busy times include waits for a core; these do not.
+  double busy_collector_cpu_ms = 0.0, collector_cpu_max_ms = 0.0;
   /// The configuration that ran.
   std::string mode;
   int workers = 1, tiles = 1, tokens = 1, threads = 0;

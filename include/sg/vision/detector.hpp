@@ -2,12 +2,14 @@
 /// The collector's labelling step around pure functions: owns the past disparity maps and the
 /// hysteresis state; one Detection per frame, in frame order.
 ///
-/// A frame passes three steps, which a pipeline may run on different threads:
+/// A frame passes four steps, which a pipeline may run on different threads:
 ///   prepare (serial, in frame order: checks, history)  -> LabelJob
 ///   LabelJob::run on row ranges (any threads, tiles)   -> per-pixel danger, TTC, velocity
-///   finish  (serial, in frame order: obstacles, signals) -> Detection
-/// process() runs the three in a row. prepare and finish touch disjoint state, so the prepare of
-/// frame i + 1 may run while frame i's labelling or finish is still running.
+///   LabelJob::conclude (any thread, once all rows ran)  -> cleaned mask, obstacles, region counts
+///   finish  (serial, in frame order: tracking, signals) -> Detection
+/// process() runs them in a row. prepare and finish touch disjoint state, so the prepare of
+/// frame i + 1 may run while frame i's labelling or finish is still running; conclude touches
+/// only its job, so the jobs of several frames may conclude at once.
 #include <deque>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -45,6 +47,12 @@ class LabelJob {
  public:
   /// Labels rows `rows` (cv::Range::all(): every row).
   void run(cv::Range rows);
+  /// The per-frame work of finish that needs the whole mask but no state kept between frames:
+  /// in Stereo-Flow mode growing the blobs into the depth-edge margin (scene_flow.grow_into_edges)
+  /// and clearing the ground (scene_flow.exclude_ground), then cleaning the mask and finding the
+  /// obstacles (extract_obstacles) and the dangerous pixels per region. Call once, after every
+  /// row was run; Detector::finish calls it when nobody did.
+  void conclude();
   /// True when run() accepts row ranges (Stereo-Flow mode); otherwise call run(all) once.
   bool tileable() const { return flow_mode_; }
   /// Image rows.
@@ -65,6 +73,9 @@ class LabelJob {
   /// the current orientation; empty = no compensation.
   std::vector<cv::Matx33d> derotations_;
   cv::Mat danger_, ttc_, velocity_;
+  bool concluded_ = false;
+  std::vector<core::Obstacle> obstacles_;  ///< conclude(): untracked obstacles
+  std::vector<int> region_pixels_;         ///< conclude(): dangerous pixels per region
 };
 
 class Detector {
@@ -87,10 +98,11 @@ class Detector {
   /// changes within the stream, or when frames come out of order.
   LabelJob prepare(const core::StereoFrame& frame, FrameMaps maps);
 
-  /// Turns a labelled frame into its Detection: in Stereo-Flow mode with
-  /// scene_flow.grow_into_edges the dangerous blobs grow back over the depth-edge margin
-  /// (grow_danger_into_edges); with scene_flow.exclude_ground, dangerous pixels on or below a ground plane fitted to D_i are
-  /// cleared; then obstacles (with the mean 3D velocity in Stereo-Flow mode) tracked over frames
+  /// Turns a labelled frame into its Detection: LabelJob::conclude unless it ran (in Stereo-Flow
+  /// mode with scene_flow.grow_into_edges the dangerous blobs grow back over the depth-edge margin
+  /// (grow_danger_into_edges); with scene_flow.exclude_ground, dangerous pixels on or below a
+  /// ground plane fitted to D_i are cleared; the obstacles, with the mean 3D velocity in
+  /// Stereo-Flow mode, are extracted); then the obstacles are tracked over frames
   /// with their TTC from a fit (ObstacleTracker), region counts, hysteresis, severity (held by
   /// SeverityHold) and steering. Fills frame and time_s from `frame`, danger = the cleaned
   /// mask; leaves latency_ms to the caller. Jobs must come in the order of prepare.
