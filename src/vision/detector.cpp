@@ -7,6 +7,7 @@
 #include "sg/vision/edge_margin.hpp"
 #include "sg/vision/ego_motion.hpp"
 #include "sg/vision/labelling.hpp"
+#include "sg/vision/segment_motion.hpp"
 
 namespace sg::vision {
 
@@ -122,6 +123,14 @@ core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) 
   det.time_s = frame.time_s;
   const cv::Mat& disp = job.disparity_;
   const core::SceneFlowParams& sf = params_.scene_flow;
+  if (job.flow_mode_ && sf.pool_surface_motion) {
+    // The velocities come from the longest gap that knows them: the noise gate uses its span.
+    const double span_s = job.spans_s_.empty()
+                              ? 0.0
+                              : *std::max_element(job.spans_s_.begin(), job.spans_s_.end());
+    pool_surface_motion(disp, camera_, params_.envelope, sf, span_s, job.danger_, job.ttc_,
+                        job.velocity_);
+  }
   if (job.flow_mode_ && sf.grow_into_edges)
     grow_danger_into_edges(disp, job.edges_, sf.edge_margin_px, sf.edge_step_px,
                            params_.signal.open_size, job.danger_, job.ttc_, job.velocity_);
