@@ -125,9 +125,8 @@ core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) 
   const core::SceneFlowParams& sf = params_.scene_flow;
   if (job.flow_mode_ && sf.pool_surface_motion) {
     // The velocities come from the longest gap that knows them: the noise gate uses its span.
-    const double span_s = job.spans_s_.empty()
-                              ? 0.0
-                              : *std::max_element(job.spans_s_.begin(), job.spans_s_.end());
+    const double span_s =
+        job.spans_s_.empty() ? 0.0 : *std::max_element(job.spans_s_.begin(), job.spans_s_.end());
     pool_surface_motion(disp, camera_, params_.envelope, sf, span_s, job.danger_, job.ttc_,
                         job.velocity_);
   }

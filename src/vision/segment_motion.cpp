@@ -16,11 +16,16 @@ bool finite(const cv::Vec3f& v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
 }
 
-/// Median of v (reordered); the lower middle value for an even count (a value that occurs).
-float median_of(std::vector<float>& v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>((v.size() - 1) / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
+/// Interquartile mean of v (reordered): the mean of the middle half. Robust like the median to
+/// the pixels paired across an occlusion, but not stuck to the 1/16 px grid of the matcher's
+/// disparities as a median of nearly equal quantized values is (at 19 m the disparity grows by
+/// 0.55 px over 20 frames: a 1/32 px offset is a 6 % TTC error).
+float interquartile_mean(std::vector<float>& v) {
+  std::sort(v.begin(), v.end());
+  const size_t quarter = v.size() / 4;
+  double sum = 0.0;
+  for (size_t i = quarter; i < v.size() - quarter; ++i) sum += v[i];
+  return static_cast<float>(sum / static_cast<double>(v.size() - 2 * quarter));
 }
 
 }  // namespace
@@ -44,7 +49,7 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
   }
   cv::Mat labels;
   const int count = cv::connectedComponents(known, labels, 8, CV_32S);
-  // Velocity components per surface, then their medians.
+  // Velocity components per surface, then their interquartile means.
   std::vector<std::vector<float>> vx(static_cast<size_t>(count)), vy(vx.size()), vz(vx.size());
   for (int y = 0; y < disp.rows; ++y) {
     const int* l = labels.ptr<int>(y);
@@ -59,7 +64,8 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
   }
   std::vector<cv::Vec3f> pooled(static_cast<size_t>(count), cv::Vec3f(kNaN, kNaN, kNaN));
   for (size_t s = 1; s < pooled.size(); ++s)
-    pooled[s] = cv::Vec3f(median_of(vx[s]), median_of(vy[s]), median_of(vz[s]));
+    pooled[s] =
+        cv::Vec3f(interquartile_mean(vx[s]), interquartile_mean(vy[s]), interquartile_mean(vz[s]));
 
   const double max_speed2 = p.max_speed_mps * p.max_speed_mps;
   const double fb = cam.focal_px * cam.baseline_m;

@@ -131,6 +131,20 @@ TEST(PoolSurfaceMotion, SurfacesKeepTheirOwnVelocityAndOutliersDoNotCount) {
   EXPECT_EQ(cv::countNonZero(m.danger(kLeft)), kLeft.area());
 }
 
+// Velocities from quantized disparities cluster on a few values; the pooled velocity must average
+// over them (here 40 % read -2.1 and 60 % -2.0 m/s, mean -2.04), not snap to one as a median does.
+TEST(PoolSurfaceMotion, PooledVelocityIsNotStuckToTheQuantizationGrid) {
+  const core::SceneFlowParams p;
+  Maps m;
+  cv::RNG rng(15);
+  m.patch(kLeft, 6.0, {0, 0, -2.0}, 0.0, rng);
+  for (int y = kLeft.y; y < kLeft.br().y; ++y)
+    for (int x = kLeft.x; x < kLeft.x + kLeft.width * 2 / 5; ++x)
+      m.velocity.at<cv::Vec3f>(y, x)[2] = -2.1f;
+  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.danger, m.ttc, m.velocity);
+  EXPECT_NEAR(m.velocity.at<cv::Vec3f>(60, 50)[2], -2.04, 0.015);
+}
+
 TEST(PoolSurfaceMotion, MismatchedMapsAreAnInputError) {
   Maps m;
   cv::Mat small_ttc(10, 10, CV_32F);

@@ -20,8 +20,9 @@ namespace sg::vision {
 /// of the pixels whose velocity is known (finite in `velocity`, CV_32FC3 m/s, NaN where unknown)
 /// and whose disparity (disp, CV_32F, invalid < 0) is valid; the depth-edge margin of the
 /// labelling already separates surfaces at different depths, since no pixel near a depth step
-/// has a velocity. Each surface's velocity is the per-component median of its pixels' velocities
-/// (robust to the minority paired across an occlusion). Every pixel of the surface is then tested
+/// has a velocity. Each surface's velocity is the per-component interquartile mean of its
+/// pixels' velocities (robust to the minority paired across an occlusion, and unlike a median not
+/// stuck to the matcher's 1/16 px disparity grid). Every pixel of the surface is then tested
 /// again with its own position P(p) (from disp) and that velocity: faster than p.max_speed_mps
 /// is a mismatch; the noise gate of the labelling applies to the pooled motion, so the
 /// disparity that P(p) had `span_s` seconds ago at that velocity, f B / (Z - V_z span_s), must be
