@@ -127,8 +127,8 @@ core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) 
     // The velocities come from the longest gap that knows them: the noise gate uses its span.
     const double span_s =
         job.spans_s_.empty() ? 0.0 : *std::max_element(job.spans_s_.begin(), job.spans_s_.end());
-    pool_surface_motion(disp, camera_, params_.envelope, sf, span_s, job.danger_, job.ttc_,
-                        job.velocity_);
+    pool_surface_motion(disp, camera_, params_.envelope, sf, span_s, job.edges_, job.danger_,
+                        job.ttc_, job.velocity_);
   }
   if (job.flow_mode_ && sf.grow_into_edges)
     grow_danger_into_edges(disp, job.edges_, sf.edge_margin_px, sf.edge_step_px,

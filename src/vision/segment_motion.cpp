@@ -31,31 +31,40 @@ float interquartile_mean(std::vector<float>& v) {
 }  // namespace
 
 void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const core::Envelope& env,
-                         const core::SceneFlowParams& p, double span_s, cv::Mat& danger,
-                         cv::Mat& ttc, cv::Mat& velocity) {
-  if (disp.type() != CV_32FC1 || danger.type() != CV_8UC1 || ttc.type() != CV_32FC1 ||
-      velocity.type() != CV_32FC3 || danger.size() != disp.size() || ttc.size() != disp.size() ||
-      velocity.size() != disp.size())
+                         const core::SceneFlowParams& p, double span_s, const cv::Mat& edges,
+                         cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity) {
+  if (disp.type() != CV_32FC1 || edges.type() != CV_8UC1 || danger.type() != CV_8UC1 ||
+      ttc.type() != CV_32FC1 || velocity.type() != CV_32FC3 || edges.size() != disp.size() ||
+      danger.size() != disp.size() || ttc.size() != disp.size() || velocity.size() != disp.size())
     throw core::InputError(
         "surface motion: maps must be CV_32F disparity, CV_8U danger, CV_32F TTC and CV_32FC3 "
         "velocity of one size");
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  cv::Mat known(disp.size(), CV_8UC1);
+  // The labelling's candidates: valid, near enough, off the depth-edge margin, in the band.
+  const float d_min = static_cast<float>(cam.focal_px * cam.baseline_m / p.z_max_m);
+  cv::Mat candidate(disp.size(), CV_8UC1);
   for (int y = 0; y < disp.rows; ++y) {
     const float* d = disp.ptr<float>(y);
-    const cv::Vec3f* v = velocity.ptr<cv::Vec3f>(y);
-    std::uint8_t* k = known.ptr<std::uint8_t>(y);
-    for (int x = 0; x < disp.cols; ++x) k[x] = d[x] > 0.0f && finite(v[x]) ? 255 : 0;
+    const std::uint8_t* e = edges.ptr<std::uint8_t>(y);
+    std::uint8_t* c = candidate.ptr<std::uint8_t>(y);
+    for (int x = 0; x < disp.cols; ++x) {
+      bool ok = d[x] > 0.0f && d[x] >= d_min && e[x] == 0;
+      if (ok && p.use_envelope_band) {
+        const double Y = (y - cam.cy) * cam.baseline_m / d[x];
+        ok = Y >= env.y_top_m && Y <= env.y_bottom_m;
+      }
+      c[x] = ok ? 255 : 0;
+    }
   }
   cv::Mat labels;
-  const int count = cv::connectedComponents(known, labels, 8, CV_32S);
+  const int count = cv::connectedComponents(candidate, labels, 8, CV_32S);
   // Velocity components per surface, then their interquartile means.
   std::vector<std::vector<float>> vx(static_cast<size_t>(count)), vy(vx.size()), vz(vx.size());
   for (int y = 0; y < disp.rows; ++y) {
     const int* l = labels.ptr<int>(y);
     const cv::Vec3f* v = velocity.ptr<cv::Vec3f>(y);
     for (int x = 0; x < disp.cols; ++x) {
-      if (l[x] == 0) continue;
+      if (l[x] == 0 || !finite(v[x])) continue;
       const auto s = static_cast<size_t>(l[x]);
       vx[s].push_back(v[x][0]);
       vy[s].push_back(v[x][1]);
@@ -64,8 +73,9 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
   }
   std::vector<cv::Vec3f> pooled(static_cast<size_t>(count), cv::Vec3f(kNaN, kNaN, kNaN));
   for (size_t s = 1; s < pooled.size(); ++s)
-    pooled[s] =
-        cv::Vec3f(interquartile_mean(vx[s]), interquartile_mean(vy[s]), interquartile_mean(vz[s]));
+    if (!vx[s].empty())
+      pooled[s] = cv::Vec3f(interquartile_mean(vx[s]), interquartile_mean(vy[s]),
+                            interquartile_mean(vz[s]));
 
   const double max_speed2 = p.max_speed_mps * p.max_speed_mps;
   const double fb = cam.focal_px * cam.baseline_m;
@@ -78,7 +88,7 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
     for (int x = 0; x < disp.cols; ++x) {
       out[x] = 0;
       t[x] = kNaN;
-      if (l[x] == 0) {
+      if (l[x] == 0 || !finite(pooled[static_cast<size_t>(l[x])])) {
         v[x] = cv::Vec3f(kNaN, kNaN, kNaN);
         continue;
       }

@@ -37,11 +37,12 @@ core::Envelope wide() {
 /// Maps of a scene: background at 25 m with unknown velocity, and patches at their depths whose
 /// pixels carry `v` plus Gaussian noise of sigma `noise` m/s per component (fixed seed).
 struct Maps {
-  cv::Mat disp, danger, ttc, velocity;
+  cv::Mat disp, edges, danger, ttc, velocity;
   Maps() {
     const core::Camera c = camera();
     disp = cv::Mat(c.height, c.width, CV_32F, cv::Scalar(c.disparity(25.0)));
     danger = cv::Mat::zeros(disp.size(), CV_8U);
+    edges = cv::Mat::zeros(disp.size(), CV_8U);
     ttc = cv::Mat(disp.size(), CV_32F, cv::Scalar(kNaN));
     velocity = cv::Mat(disp.size(), CV_32FC3, cv::Scalar(kNaN, kNaN, kNaN));
   }
@@ -77,14 +78,14 @@ TEST(PoolSurfaceMotion, TtcJustOverTheHorizonRaisesNoPixelOnceItIsPooled) {
   const double vz = -(6.0 - 0.5) / 3.3;
   m.patch(kLeft, 6.0, {0, 0, vz}, 0.15 * -vz, rng);
   EXPECT_GT(m.per_pixel_dangerous(kLeft, p), 150);  // the early alarm pooling removes
-  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.danger, m.ttc, m.velocity);
+  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity);
   EXPECT_EQ(cv::countNonZero(m.danger), 0);
   const cv::Vec3f v = m.velocity.at<cv::Vec3f>(60, 50);
   EXPECT_NEAR(v[2], vz, 0.05 * -vz);
 }
 
 // Just under the horizon (2.7 s) the whole patch is dangerous with about the true TTC, where the
-// per-pixel test keeps only part of it.
+// per-pixel test keeps only part of it; the background beyond z_max is no surface.
 TEST(PoolSurfaceMotion, TtcJustUnderTheHorizonMarksTheWholeSurface) {
   const core::SceneFlowParams p;
   Maps m;
@@ -92,7 +93,10 @@ TEST(PoolSurfaceMotion, TtcJustUnderTheHorizonMarksTheWholeSurface) {
   const double vz = -(6.0 - 0.5) / 2.7;
   m.patch(kLeft, 6.0, {0, 0, vz}, 0.15 * -vz, rng);
   EXPECT_LT(m.per_pixel_dangerous(kLeft, p), kLeft.area() * 9 / 10);
-  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.danger, m.ttc, m.velocity);
+  // Candidates without a velocity of their own (their source lay near a past edge) take the
+  // surface's.
+  m.velocity(cv::Rect(40, 50, 10, 10)).setTo(cv::Scalar(kNaN, kNaN, kNaN));
+  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity);
   EXPECT_EQ(cv::countNonZero(m.danger(kLeft)), kLeft.area());
   EXPECT_EQ(cv::countNonZero(m.danger), kLeft.area());
   EXPECT_NEAR(m.ttc.at<float>(60, 50), 2.7, 0.1);
@@ -107,13 +111,13 @@ TEST(PoolSurfaceMotion, MotionTooSmallToShowOverTheSpanIsNoise) {
   Maps m;
   cv::RNG rng(14);
   m.patch(kLeft, 6.0, {0, 0, -(6.0 - 0.5) / 2.7}, 0.0, rng);
-  pool_surface_motion(m.disp, camera(), wide(), p, 0.05, m.danger, m.ttc, m.velocity);
+  pool_surface_motion(m.disp, camera(), wide(), p, 0.05, m.edges, m.danger, m.ttc, m.velocity);
   EXPECT_EQ(cv::countNonZero(m.danger), 0);
-  pool_surface_motion(m.disp, camera(), wide(), p, 0.5, m.danger, m.ttc, m.velocity);
+  pool_surface_motion(m.disp, camera(), wide(), p, 0.5, m.edges, m.danger, m.ttc, m.velocity);
   EXPECT_EQ(cv::countNonZero(m.danger), kLeft.area());
 }
 
-// Surfaces apart (unknown pixels between them) keep their own velocities: an approaching patch
+// Surfaces apart (pixels beyond z_max between them) keep their own velocities: an approaching patch
 // does not make a static one beside it dangerous; a minority of mismatched pixels (20 % at 30 m/s
 // towards the camera) does not move the median.
 TEST(PoolSurfaceMotion, SurfacesKeepTheirOwnVelocityAndOutliersDoNotCount) {
@@ -124,7 +128,7 @@ TEST(PoolSurfaceMotion, SurfacesKeepTheirOwnVelocityAndOutliersDoNotCount) {
   m.patch(kRight, 5.0, {0, 0, 0}, 0.2, rng);
   for (int y = kRight.y; y < kRight.br().y; ++y)
     for (int x = kRight.x; x < kRight.x + 8; ++x) m.velocity.at<cv::Vec3f>(y, x) = {0, 0, -30};
-  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.danger, m.ttc, m.velocity);
+  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity);
   EXPECT_EQ(cv::countNonZero(m.danger(kRight)), 0);
   EXPECT_NEAR(m.velocity.at<cv::Vec3f>(60, 120)[2], 0.0, 0.1);
   EXPECT_NEAR(m.velocity.at<cv::Vec3f>(60, 50)[2], -2.0, 0.1);
@@ -141,7 +145,7 @@ TEST(PoolSurfaceMotion, PooledVelocityIsNotStuckToTheQuantizationGrid) {
   for (int y = kLeft.y; y < kLeft.br().y; ++y)
     for (int x = kLeft.x; x < kLeft.x + kLeft.width * 2 / 5; ++x)
       m.velocity.at<cv::Vec3f>(y, x)[2] = -2.1f;
-  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.danger, m.ttc, m.velocity);
+  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity);
   EXPECT_NEAR(m.velocity.at<cv::Vec3f>(60, 50)[2], -2.04, 0.015);
 }
 
@@ -149,7 +153,7 @@ TEST(PoolSurfaceMotion, MismatchedMapsAreAnInputError) {
   Maps m;
   cv::Mat small_ttc(10, 10, CV_32F);
   EXPECT_THROW(pool_surface_motion(m.disp, camera(), core::Envelope{}, core::SceneFlowParams{}, 2.0,
-                                   m.danger, small_ttc, m.velocity),
+                                   m.edges, m.danger, small_ttc, m.velocity),
                core::InputError);
 }
 
