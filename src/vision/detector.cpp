@@ -7,6 +7,7 @@
 #include "sg/vision/edge_margin.hpp"
 #include "sg/vision/ego_motion.hpp"
 #include "sg/vision/labelling.hpp"
+#include "sg/vision/segment_motion.hpp"
 
 namespace sg::vision {
 
@@ -120,6 +121,13 @@ void LabelJob::conclude() {
   if (concluded_) return;
   const core::DetectorParams& p = *params_;
   const core::SceneFlowParams& sf = p.scene_flow;
+  if (flow_mode_ && sf.pool_surface_motion) {
+    // The velocities come from the longest gap that knows them: the noise gate uses its span.
+    const double span_s =
+        spans_s_.empty() ? 0.0 : *std::max_element(spans_s_.begin(), spans_s_.end());
+    pool_surface_motion(disparity_, *camera_, p.envelope, sf, span_s, edges_, danger_, ttc_,
+                        velocity_);
+  }
   if (flow_mode_ && sf.grow_into_edges)
     grow_danger_into_edges(disparity_, edges_, sf.edge_margin_px, sf.edge_step_px,
                            p.signal.open_size, danger_, ttc_, velocity_);

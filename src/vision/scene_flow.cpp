@@ -322,20 +322,24 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
         const GapResult res = test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x],
                                    d_prev, g.span_s, g.derotate);
         if (!res.velocity_known) continue;
-        const bool dangerous = res.dangerous && !past_edge(g, q[x]);
+        // A source near a past depth edge pairs the object now with the background before (or
+        // the reverse): neither its verdict nor its velocity can be trusted.
+        const bool at_edge = past_edge(g, q[x]);
+        const bool dangerous = res.dangerous && !at_edge;
+        const cv::Vec3f v = at_edge ? unknown : cv::Vec3f(res.velocity);
         if (p.longest_gap_decides) {
           // Gaps ascend: each known estimate replaces those of the shorter, noisier gaps.
           danger_row[x] = dangerous ? 255 : 0;
           ttc_row[x] = dangerous ? static_cast<float>(res.ttc) : kNaN;
-          vel_row[x] = cv::Vec3f(res.velocity);
+          vel_row[x] = v;
         } else if (dangerous) {
           if (danger_row[x] == 0 || res.ttc < ttc_row[x]) {
             ttc_row[x] = static_cast<float>(res.ttc);
             vel_row[x] = cv::Vec3f(res.velocity);
           }
           danger_row[x] = 255;
-        } else if (danger_row[x] == 0) {
-          vel_row[x] = cv::Vec3f(res.velocity);  // larger gaps come later: least noisy wins
+        } else if (danger_row[x] == 0 && !at_edge) {
+          vel_row[x] = v;  // larger gaps come later: least noisy wins
         }
       }
     }

@@ -35,7 +35,11 @@ ObstacleTracker::ObstacleTracker(const core::SignalParams& p, double z_contact_m
     : p_(p), z_contact_m_(z_contact_m) {}
 
 void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacles) {
-  // Every (overlap, track, obstacle) pair that overlaps enough, best first.
+  // Every (likeness, track, obstacle) pair that overlaps enough, most alike first. A pair
+  // overlaps enough when the intersection covers track_min_overlap of the smaller box; it is
+  // ranked by intersection over union, so that when a blob splits (noise cuts a fragment off)
+  // its track goes on with the main part, not with a fragment lying inside its old box, which
+  // would restart the main part's TTC fit.
   std::vector<std::tuple<double, size_t, size_t>> pairs;
   for (size_t k = 0; k < tracks_.size(); ++k)
     for (size_t j = 0; j < obstacles.size(); ++j) {
@@ -43,8 +47,9 @@ void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacl
       const cv::Rect& b = obstacles[j].bbox;
       const double smaller = std::min(a.area(), b.area());
       if (smaller <= 0) continue;
-      const double overlap = (a & b).area() / smaller;
-      if (overlap >= p_.track_min_overlap) pairs.emplace_back(overlap, k, j);
+      const double common = (a & b).area();
+      if (common / smaller >= p_.track_min_overlap)
+        pairs.emplace_back(common / (a.area() + b.area() - common), k, j);
     }
   std::sort(pairs.begin(), pairs.end(),
             [](const auto& x, const auto& y) { return std::get<0>(x) > std::get<0>(y); });

@@ -69,6 +69,28 @@ TEST(ObstacleTracker, FittedTtcFollowsTheTruthThroughNoiseAndDrops) {
   EXPECT_GT(fitted, 35);
 }
 
+// A blob that splits into its main part and a small fragment inside its old box: the track goes on
+// with the main part (its fit keeps its samples), the fragment starts a track of its own, although
+// the fragment lies wholly inside the old box and the main part, shifted, only mostly.
+TEST(ObstacleTracker, SplitBlobKeepsItsTrackOnTheMainPart) {
+  core::SignalParams p;
+  ObstacleTracker tracker(p, 0.5);
+  std::vector<core::Obstacle> obs;
+  for (int i = 0; i < 6; ++i) {
+    obs = {box_at(cv::Rect(100, 100, 50, 60), 9.0 - 0.1 * i, 3.0)};
+    tracker.update(i / 30.0, obs);
+  }
+  const int id = obs[0].track_id;
+  obs = {box_at(cv::Rect(102, 102, 52, 62), 8.4, 3.0),
+         box_at(cv::Rect(130, 130, 12, 20), 8.4, 3.0)};
+  tracker.update(6 / 30.0, obs);
+  EXPECT_EQ(obs[0].track_id, id);
+  EXPECT_NE(obs[1].track_id, id);
+  // The main part's fit still spans the seven frames: 3 m/s.
+  ASSERT_TRUE(obs[0].closing_speed_mps);
+  EXPECT_NEAR(*obs[0].closing_speed_mps, 3.0, 1e-6);
+}
+
 TEST(SeverityHold, RisesAtOnceFallsAfterItsFrames) {
   core::SignalParams p;
   p.severity_off_frames = 3;

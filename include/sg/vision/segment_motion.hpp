@@ -1,0 +1,39 @@
+#pragma once
+/// Rigid-motion pooling of the Stereo-Flow labelling (DESIGN 3.2, docs/stereo-flow.md).
+///
+/// The per-pixel velocity of label_stereo_flow_rows is noisy: over a 20-frame gap the disparity
+/// of a box 7 m away grows by about 1.4 px while block matching is off by about 0.1 px a pixel,
+/// so per-pixel TTCs scatter by about 10 %. Tested pixel by pixel, a large object whose true TTC
+/// is 10 % over the horizon still has hundreds of pixels under it (an early alarm), and a small
+/// far one whose TTC is just under it has too few to pass min_area (a late one). The points of
+/// one rigid object share one velocity (a translation; a turn adds a part that varies little
+/// across an object), so the velocity is pooled over the surface a pixel lies on before the
+/// envelope test: its noise then falls with the square root of the surface's pixel count.
+#include <opencv2/core.hpp>
+
+#include "sg/core/camera.hpp"
+#include "sg/core/params.hpp"
+
+namespace sg::vision {
+
+/// Relabels a Stereo-Flow frame with pooled velocities. Surfaces are the 8-connected components
+/// of the labelling's candidates: valid disparity (disp, CV_32F, invalid < 0) with Z <= p.z_max_m,
+/// off the depth-edge margin (`edges`, CV_8U, 255 = near a depth edge: depth_edges()) and, with
+/// p.use_envelope_band, inside the envelope's vertical band now; the margin separates surfaces
+/// at different depths. Each surface's velocity is the per-component interquartile mean of the
+/// velocities its pixels know (finite in `velocity`, CV_32FC3 m/s): robust to the minority paired
+/// across an occlusion, and unlike a median not stuck to the matcher's 1/16 px disparity grid.
+/// Candidates whose own velocity is unknown (a source near a past depth edge) take it too.
+/// Every pixel of a surface with a velocity is then tested with its own position P(p) and that
+/// velocity: faster than p.max_speed_mps is a mismatch; the noise gate of the labelling applies
+/// to the pooled motion, so the disparity that P(p) had `span_s` seconds ago at that velocity,
+/// f B / (Z - V_z span_s), must be at least p.min_delta_d_px below disp(p) (span_s = the longest
+/// gap's time: a motion too small to show over the gaps measured is noise, as at the start of a
+/// stream with gap 1 only); then heads_into_envelope(P, V, env, p.v_min_mps). Outputs,
+/// overwritten at every pixel: danger CV_8U 0/255, ttc CV_32F (s, NaN where safe), velocity =
+/// the surface's velocity (NaN elsewhere). All maps the same size.
+void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const core::Envelope& env,
+                         const core::SceneFlowParams& p, double span_s, const cv::Mat& edges,
+                         cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity);
+
+}  // namespace sg::vision

@@ -1,0 +1,161 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "sg/core/error.hpp"
+#include "sg/vision/scene_flow.hpp"
+#include "sg/vision/segment_motion.hpp"
+
+namespace sg::vision {
+namespace {
+
+/// f*B = 50 px*m, 161 x 121.
+core::Camera camera() {
+  core::Camera c;
+  c.width = 161;
+  c.height = 121;
+  c.focal_px = 100.0;
+  c.baseline_m = 0.5;
+  c.cx = 80.0;
+  c.cy = 60.0;
+  c.fps = 10.0;
+  return c;
+}
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+/// An envelope wide and tall enough to hold every patch below: only the TTC decides.
+core::Envelope wide() {
+  core::Envelope e;
+  e.half_width_m = 5.0;
+  e.y_top_m = -5.0;
+  e.y_bottom_m = 5.0;
+  return e;
+}
+
+/// Maps of a scene: background at 25 m with unknown velocity, and patches at their depths whose
+/// pixels carry `v` plus Gaussian noise of sigma `noise` m/s per component (fixed seed).
+struct Maps {
+  cv::Mat disp, edges, danger, ttc, velocity;
+  Maps() {
+    const core::Camera c = camera();
+    disp = cv::Mat(c.height, c.width, CV_32F, cv::Scalar(c.disparity(25.0)));
+    danger = cv::Mat::zeros(disp.size(), CV_8U);
+    edges = cv::Mat::zeros(disp.size(), CV_8U);
+    ttc = cv::Mat(disp.size(), CV_32F, cv::Scalar(kNaN));
+    velocity = cv::Mat(disp.size(), CV_32FC3, cv::Scalar(kNaN, kNaN, kNaN));
+  }
+  void patch(const cv::Rect& r, double z, cv::Vec3d v, double noise, cv::RNG& rng) {
+    disp(r).setTo(camera().disparity(z));
+    for (int y = r.y; y < r.br().y; ++y)
+      for (int x = r.x; x < r.br().x; ++x)
+        velocity.at<cv::Vec3f>(y, x) =
+            cv::Vec3f(v + cv::Vec3d(rng.gaussian(noise), rng.gaussian(noise), rng.gaussian(noise)));
+  }
+  /// Pixels of r whose own velocity passes the envelope test (the per-pixel labelling).
+  int per_pixel_dangerous(const cv::Rect& r, const core::SceneFlowParams& p) const {
+    int n = 0;
+    for (int y = r.y; y < r.br().y; ++y)
+      for (int x = r.x; x < r.br().x; ++x) {
+        double t = 0;
+        const cv::Vec3d V(velocity.at<cv::Vec3f>(y, x));
+        n += heads_into_envelope(camera().point(x, y, disp.at<float>(y, x)), V, wide(), p.v_min_mps,
+                                 t);
+      }
+    return n;
+  }
+};
+
+const cv::Rect kLeft(30, 40, 40, 40), kRight(100, 40, 40, 40);
+
+// The velocity of a point 6 m ahead whose TTC is 3.3 s, 10 % over the 3 s horizon, measured with
+// a 15 % noise per pixel: pixel by pixel a large part of the patch looks dangerous; pooled, none.
+TEST(PoolSurfaceMotion, TtcJustOverTheHorizonRaisesNoPixelOnceItIsPooled) {
+  const core::SceneFlowParams p;
+  Maps m;
+  cv::RNG rng(11);
+  const double vz = -(6.0 - 0.5) / 3.3;
+  m.patch(kLeft, 6.0, {0, 0, vz}, 0.15 * -vz, rng);
+  EXPECT_GT(m.per_pixel_dangerous(kLeft, p), 150);  // the early alarm pooling removes
+  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity);
+  EXPECT_EQ(cv::countNonZero(m.danger), 0);
+  const cv::Vec3f v = m.velocity.at<cv::Vec3f>(60, 50);
+  EXPECT_NEAR(v[2], vz, 0.05 * -vz);
+}
+
+// Just under the horizon (2.7 s) the whole patch is dangerous with about the true TTC, where the
+// per-pixel test keeps only part of it; the background beyond z_max is no surface.
+TEST(PoolSurfaceMotion, TtcJustUnderTheHorizonMarksTheWholeSurface) {
+  const core::SceneFlowParams p;
+  Maps m;
+  cv::RNG rng(12);
+  const double vz = -(6.0 - 0.5) / 2.7;
+  m.patch(kLeft, 6.0, {0, 0, vz}, 0.15 * -vz, rng);
+  EXPECT_LT(m.per_pixel_dangerous(kLeft, p), kLeft.area() * 9 / 10);
+  // Candidates without a velocity of their own (their source lay near a past edge) take the
+  // surface's.
+  m.velocity(cv::Rect(40, 50, 10, 10)).setTo(cv::Scalar(kNaN, kNaN, kNaN));
+  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity);
+  EXPECT_EQ(cv::countNonZero(m.danger(kLeft)), kLeft.area());
+  EXPECT_EQ(cv::countNonZero(m.danger), kLeft.area());
+  EXPECT_NEAR(m.ttc.at<float>(60, 50), 2.7, 0.1);
+  EXPECT_TRUE(std::isnan(m.ttc.at<float>(10, 10)));
+  EXPECT_TRUE(std::isnan(m.velocity.at<cv::Vec3f>(10, 10)[0]));
+}
+
+// The noise gate of the labelling holds for the pooled motion: a motion that would grow the
+// disparity by less than min_delta_d_px over the gaps measured (here 0.14 px over 0.05 s) is noise.
+TEST(PoolSurfaceMotion, MotionTooSmallToShowOverTheSpanIsNoise) {
+  const core::SceneFlowParams p;
+  Maps m;
+  cv::RNG rng(14);
+  m.patch(kLeft, 6.0, {0, 0, -(6.0 - 0.5) / 2.7}, 0.0, rng);
+  pool_surface_motion(m.disp, camera(), wide(), p, 0.05, m.edges, m.danger, m.ttc, m.velocity);
+  EXPECT_EQ(cv::countNonZero(m.danger), 0);
+  pool_surface_motion(m.disp, camera(), wide(), p, 0.5, m.edges, m.danger, m.ttc, m.velocity);
+  EXPECT_EQ(cv::countNonZero(m.danger), kLeft.area());
+}
+
+// Surfaces apart (pixels beyond z_max between them) keep their own velocities: an approaching patch
+// does not make a static one beside it dangerous; a minority of mismatched pixels (20 % at 30 m/s
+// towards the camera) does not move the median.
+TEST(PoolSurfaceMotion, SurfacesKeepTheirOwnVelocityAndOutliersDoNotCount) {
+  const core::SceneFlowParams p;
+  Maps m;
+  cv::RNG rng(13);
+  m.patch(kLeft, 5.0, {0.1, 0, -2.0}, 0.2, rng);
+  m.patch(kRight, 5.0, {0, 0, 0}, 0.2, rng);
+  for (int y = kRight.y; y < kRight.br().y; ++y)
+    for (int x = kRight.x; x < kRight.x + 8; ++x) m.velocity.at<cv::Vec3f>(y, x) = {0, 0, -30};
+  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity);
+  EXPECT_EQ(cv::countNonZero(m.danger(kRight)), 0);
+  EXPECT_NEAR(m.velocity.at<cv::Vec3f>(60, 120)[2], 0.0, 0.1);
+  EXPECT_NEAR(m.velocity.at<cv::Vec3f>(60, 50)[2], -2.0, 0.1);
+  EXPECT_EQ(cv::countNonZero(m.danger(kLeft)), kLeft.area());
+}
+
+// Velocities from quantized disparities cluster on a few values; the pooled velocity must average
+// over them (here 40 % read -2.1 and 60 % -2.0 m/s, mean -2.04), not snap to one as a median does.
+TEST(PoolSurfaceMotion, PooledVelocityIsNotStuckToTheQuantizationGrid) {
+  const core::SceneFlowParams p;
+  Maps m;
+  cv::RNG rng(15);
+  m.patch(kLeft, 6.0, {0, 0, -2.0}, 0.0, rng);
+  for (int y = kLeft.y; y < kLeft.br().y; ++y)
+    for (int x = kLeft.x; x < kLeft.x + kLeft.width * 2 / 5; ++x)
+      m.velocity.at<cv::Vec3f>(y, x)[2] = -2.1f;
+  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity);
+  EXPECT_NEAR(m.velocity.at<cv::Vec3f>(60, 50)[2], -2.04, 0.015);
+}
+
+TEST(PoolSurfaceMotion, MismatchedMapsAreAnInputError) {
+  Maps m;
+  cv::Mat small_ttc(10, 10, CV_32F);
+  EXPECT_THROW(pool_surface_motion(m.disp, camera(), core::Envelope{}, core::SceneFlowParams{}, 2.0,
+                                   m.edges, m.danger, small_ttc, m.velocity),
+               core::InputError);
+}
+
+}  // namespace
+}  // namespace sg::vision
