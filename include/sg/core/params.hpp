@@ -173,8 +173,9 @@ struct SceneFlowParams {
   /// Pool the velocity over each surface before the envelope test (vision/segment_motion.hpp):
   /// the points of a rigid object share one velocity, and its per-pixel estimates scatter by
   /// about 10 % at 7 m, which tested pixel by pixel raises early alarms on large objects and
-  /// late ones on small far objects. Surfaces are the connected pixels with a known velocity
-  /// (the depth-edge margin separates them); each takes the median velocity of its pixels.
+  /// late ones on small far objects. Surfaces are the connected candidates of the labelling
+  /// (the depth-edge margin separates them); each takes the interquartile mean of the
+  /// velocities its pixels know.
   bool pool_surface_motion = true;
   /// Grow each dangerous blob back over the depth-edge margin (pixels of similar disparity next
   /// to it, up to edge_margin_px rounds) before the clean-up's min_area: the margin otherwise
