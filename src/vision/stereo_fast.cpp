@@ -103,7 +103,6 @@ HWY_INLINE hn::Vec<D16> CostAt(D16 d16, const RowPtrs& p, hn::Vec<D16> lv, hn::V
 /// Column x of the column sums V[x][d] (`col`): adds the costs of row `a` and, when kSub,
 /// subtracts those of row `s` (u16 arithmetic is exact modulo 2^16 and the true sums fit in 16
 /// bits, so the result is exact). kNV: vectors per disparity range, 0 = nd / Lanes at run time.
-/// Returns the first vector of the updated column (kNV > 0 callers reload the rest from L1).
 template <bool kCensus, bool kSub, int kNV, class D16>
 HWY_INLINE void UpdateColumn(D16 d16, const RowPtrs& a, const RowPtrs& s, int x, int nd,
                              std::uint16_t* HWY_RESTRICT col) {
@@ -197,11 +196,13 @@ HWY_INLINE std::uint64_t BitIn(int w, int p) {
   return (p >> 6) == w ? std::uint64_t{1} << (p & 63) : 0;
 }
 
-/// One row's block sums, winners and checks, fused: for each output pixel the newest column of V
-/// is updated (when kSub: the row moved down by one), added to the running horizontal sums S,
-/// which are reduced at once (winner, uniqueness, sub-pixel) and then lose their oldest column.
-/// kNV: vectors per disparity range, S and the reductions in registers and 64-bit masks; 0 =
-/// any range, S in memory, reduced vector by vector.
+/// One row's block sums, winners and checks, in three passes over its output pixels. 1: the
+/// newest column of V is updated (when kSub: the row moved down by one) and added to the running
+/// horizontal sums S, which are stored (j.s) with their minimum, then lose their oldest column.
+/// 2: winner and uniqueness from lane masks. 3: sub-pixel fits, vectorised. Separate passes let
+/// the core overlap pixels instead of waiting on each one's reduction chain. kNV: vectors per
+/// disparity range, S in registers and 64-bit masks; 0 = any range, S in memory, reduced vector
+/// by vector.
 template <bool kCensus, bool kSub, int kNV, class D16>
 void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
   constexpr int kMaxNV = kNV > 0 ? kNV : 1;
