@@ -47,6 +47,7 @@ struct FastJob {
   std::uint16_t* sacc = nullptr;     ///< scratch: running horizontal sums, num_disp, aligned
   std::uint16_t* mins = nullptr;     ///< scratch: per output column of a row, smallest sum
   std::uint16_t* threshs = nullptr;  ///< scratch: per output column of a row, uniqueness bound
+  std::int32_t* fit = nullptr;       ///< scratch: 5 x output columns, sub-pixel fit inputs
   std::int16_t* out = nullptr;       ///< per output row: disparity * 16 or kInvalid16
   size_t out_step = 0;
 };
@@ -102,7 +103,6 @@ HWY_INLINE hn::Vec<D16> CostAt(D16 d16, const RowPtrs& p, hn::Vec<D16> lv, hn::V
 /// Column x of the column sums V[x][d] (`col`): adds the costs of row `a` and, when kSub,
 /// subtracts those of row `s` (u16 arithmetic is exact modulo 2^16 and the true sums fit in 16
 /// bits, so the result is exact). kNV: vectors per disparity range, 0 = nd / Lanes at run time.
-/// Returns the first vector of the updated column (kNV > 0 callers reload the rest from L1).
 template <bool kCensus, bool kSub, int kNV, class D16>
 HWY_INLINE void UpdateColumn(D16 d16, const RowPtrs& a, const RowPtrs& s, int x, int nd,
                              std::uint16_t* HWY_RESTRICT col) {
@@ -196,11 +196,13 @@ HWY_INLINE std::uint64_t BitIn(int w, int p) {
   return (p >> 6) == w ? std::uint64_t{1} << (p & 63) : 0;
 }
 
-/// One row's block sums, winners and checks, fused: for each output pixel the newest column of V
-/// is updated (when kSub: the row moved down by one), added to the running horizontal sums S,
-/// which are reduced at once (winner, uniqueness, sub-pixel) and then lose their oldest column.
-/// kNV: vectors per disparity range, S and the reductions in registers and 64-bit masks; 0 =
-/// any range, S in memory, reduced vector by vector.
+/// One row's block sums, winners and checks, in three passes over its output pixels. 1: the
+/// newest column of V is updated (when kSub: the row moved down by one) and added to the running
+/// horizontal sums S, which are stored (j.s) with their minimum, then lose their oldest column.
+/// 2: winner and uniqueness from lane masks. 3: sub-pixel fits, vectorised. Separate passes let
+/// the core overlap pixels instead of waiting on each one's reduction chain. kNV: vectors per
+/// disparity range, S in registers and 64-bit masks; 0 = any range, S in memory, reduced vector
+/// by vector.
 template <bool kCensus, bool kSub, int kNV, class D16>
 void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
   constexpr int kMaxNV = kNV > 0 ? kNV : 1;
@@ -236,6 +238,11 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
   std::uint16_t* HWY_RESTRICT s = j.s;
   std::uint16_t* HWY_RESTRICT mins = j.mins;
   std::uint16_t* HWY_RESTRICT threshs = j.threshs;
+  std::int32_t* HWY_RESTRICT fb = j.fit;      // per output column: winner, its neighbours' and own
+  std::int32_t* HWY_RESTRICT fm = fb + nout;  // sums, valid flag
+  std::int32_t* HWY_RESTRICT fp = fm + nout;
+  std::int32_t* HWY_RESTRICT f0 = fp + nout;
+  std::int32_t* HWY_RESTRICT fok = f0 + nout;
   // Pass 1: block sums of every pixel of the row (kept in s) and their minimum. Nothing here
   // waits on a reduction, so consecutive pixels overlap in the core.
   for (int i = 0; i < nout; ++i) {
@@ -316,11 +323,42 @@ void MatchRow(D16 d16, const FastJob& j, int y, int* HWY_RESTRICT best) {
                           static_cast<size_t>(b < nd - 1 && cp <= thresh);
       unique = count == near;
     }
-    const int cm = c[b > 0 ? b - 1 : 0], cp = c[b < nd - 1 ? b + 1 : nd - 1];
-    const bool ok = tex[i] != 0 && (u <= 0 || unique);
-    const int d16v = (b > 0 && b < nd - 1) ? subpixel_disparity16(b, cm, m, cp) : b * 16;
-    out[i] = ok ? static_cast<std::int16_t>(d16v + min16) : kInvalid16;
+    fb[i] = b;
+    fm[i] = c[b > 0 ? b - 1 : 0];
+    fp[i] = c[b < nd - 1 ? b + 1 : nd - 1];
+    f0[i] = m;
+    fok[i] = (tex[i] != 0 && (u <= 0 || unique)) ? 1 : 0;
     best[i] = b;
+  }
+  // Pass 3: sub-pixel fits of the row, vectorised: subpixel_disparity16's truncating division is
+  // done in doubles, which is exact here (|quotient| <= 256 with a numerator below 2^24 and a
+  // denominator below 2^18: a non-integer quotient lies >= 2^-18 from an integer, far more than
+  // a double's rounding error, and an integer one is exact).
+  const hn::ScalableTag<double> dd;
+  const hn::Rebind<std::int32_t, decltype(dd)> di;
+  const hn::Rebind<std::int16_t, decltype(dd)> dw;
+  const int nf = static_cast<int>(hn::Lanes(dd));
+  const auto zero = hn::Zero(di), one = hn::Set(di, 1), last = hn::Set(di, nd - 1);
+  int i = 0;
+  for (; i + nf <= nout; i += nf) {
+    const auto b = hn::LoadU(di, fb + i), cm = hn::LoadU(di, fm + i), cp = hn::LoadU(di, fp + i);
+    const auto c0 = hn::LoadU(di, f0 + i);
+    const auto diff = hn::Sub(cm, cp);
+    const auto denom = hn::Add(hn::Sub(hn::Add(cm, cp), hn::Add(c0, c0)), hn::Abs(diff));
+    const auto q = hn::DemoteTo(di, hn::Div(hn::PromoteTo(dd, hn::ShiftLeft<8>(diff)),
+                                            hn::PromoteTo(dd, hn::Max(denom, one))));
+    const auto off = hn::IfThenZeroElse(hn::Eq(denom, zero), q);
+    const auto fit = hn::ShiftRight<4>(hn::Add(hn::Add(hn::ShiftLeft<8>(b), off), hn::Set(di, 15)));
+    const auto interior = hn::And(hn::Lt(zero, b), hn::Lt(b, last));
+    auto d16v = hn::Add(hn::IfThenElse(interior, fit, hn::ShiftLeft<4>(b)), hn::Set(di, min16));
+    d16v = hn::IfThenElse(hn::Eq(hn::LoadU(di, fok + i), zero),
+                          hn::Set(di, static_cast<std::int32_t>(kInvalid16)), d16v);
+    hn::StoreU(hn::DemoteTo(dw, d16v), dw, out + i);
+  }
+  for (; i < nout; ++i) {
+    const int b = fb[i];
+    const int d16v = (b > 0 && b < nd - 1) ? subpixel_disparity16(b, fm[i], f0[i], fp[i]) : b * 16;
+    out[i] = fok[i] != 0 ? static_cast<std::int16_t>(d16v + min16) : kInvalid16;
   }
 }
 
@@ -557,6 +595,7 @@ struct Scratch {
   std::vector<std::uint16_t> tex_cols;
   std::vector<std::uint16_t> llo, lhi, rlo, rhi;
   hwy::AlignedFreeUniquePtr<std::uint16_t[]> v, s, small;
+  std::vector<std::int32_t> fit;
   size_t v_size = 0, s_size = 0, small_size = 0;
 };
 
@@ -695,6 +734,8 @@ void match_fast_rows(const cv::Mat& left, const cv::Mat& right, const core::BmPa
   job.sacc = aligned(sc.small, sc.small_size, static_cast<size_t>(nd) + 2 * nout + 64);
   job.mins = job.sacc + nd;
   job.threshs = job.mins + nout;
+  sc.fit.resize(5 * nout);
+  job.fit = sc.fit.data();
   job.out = out16.ptr<std::int16_t>(0);
   job.out_step = out16.step1();
   HWY_DYNAMIC_DISPATCH(MatchRows)(job);
