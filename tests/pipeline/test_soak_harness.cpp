@@ -53,7 +53,7 @@ TEST(SoakHarness, SeesALeak) {
 }
 
 /// A frame lost from the stream (numbers jump from 149 to 151) fails the soak: every later frame
-/// is out of order.
+/// is out of order, and the gap is a dropped frame.
 TEST(SoakHarness, SeesALostFrame) {
   Config c = short_config();
   c.tamper = [](core::StereoFrame& f) {
@@ -62,9 +62,12 @@ TEST(SoakHarness, SeesALostFrame) {
   const Result r = run_soak(c);
   EXPECT_EQ(r.frames_out, c.frames);
   EXPECT_EQ(r.out_of_order, c.frames - 150);
+  // The pipeline counts the gap in the indices as a dropped frame too.
+  EXPECT_EQ(r.dropped, 1);
   const auto why = failures(c, r, 4.0);
-  ASSERT_EQ(why.size(), 1u);
+  ASSERT_EQ(why.size(), 2u);
   EXPECT_NE(why[0].find("out of order"), std::string::npos) << why[0];
+  EXPECT_NE(why[1].find("dropped 1"), std::string::npos) << why[1];
 }
 
 /// A repeated frame (frame 150 numbered 149) stops the run: the detector refuses it.
