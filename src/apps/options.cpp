@@ -122,8 +122,8 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                  "stereo search range, px (positive multiple of 16; default 64)");
   app.add_option("--block-size", o.block_size, "stereo block size, px (odd, 5..255)");
   app.add_option("--matcher", o.matcher,
-                 "stereo matcher: bm (OpenCV StereoBM, default), sgbm (OpenCV StereoSGBM) or fast "
-                 "(our SIMD block matcher)");
+                 "stereo matcher: fast (our SIMD block matcher, StereoBM's results; default), bm "
+                 "(OpenCV StereoBM) or sgbm (OpenCV StereoSGBM)");
   app.add_option("--cost", o.cost, "fast matcher cost: sad (default) or census");
   app.add_option("--gaps", o.gaps,
                  "frame gaps k compared by the mode's labelling, e.g. --gaps 1 (the thesis) or "

@@ -21,7 +21,7 @@ struct BenchConfig {
   int frames = 300;          ///< frames per configuration
   int num_disparities = 64;  ///< stereo search range, px
   /// Matcher of the pipeline rows (the baseline loops stay StereoBM, the reference).
-  core::Matcher matcher = core::Matcher::kBm;
+  core::Matcher matcher = core::Matcher::kFast;
   core::MatchCost cost = core::MatchCost::kSad;  ///< fast matcher's cost
   int threads = 0;           ///< task-arena size (0 = all cores)
   std::string scenario = "head-on";
