@@ -11,6 +11,23 @@
 namespace sg::pipeline::soak {
 namespace {
 
+#if defined(__SANITIZE_ADDRESS__)
+// ASan holds freed blocks in its quarantine (256 MiB by default), so resident memory grows in any
+// run: the memory verdict means nothing there. The frame counts are checked in every build.
+constexpr bool kMemoryMeasurable = false;
+#else
+constexpr bool kMemoryMeasurable = true;
+#endif
+
+/// failures() without its memory verdict when memory cannot be measured (ASan).
+std::vector<std::string> counted_failures(const Config& c, const Result& r) {
+  std::vector<std::string> out;
+  for (const std::string& why : failures(c, r, 4.0)) {
+    if (kMemoryMeasurable || why.find("memory grew") == std::string::npos) out.push_back(why);
+  }
+  return out;
+}
+
 Config short_config() {
   Config c;
   c.frames = 400;
@@ -36,10 +53,11 @@ TEST(SoakHarness, CountsEveryFrameInOrder) {
   // Samples: at start, at the warm-up end, then every sample_every frames.
   EXPECT_EQ(r.samples.size(), 1u + c.frames / c.sample_every);
   EXPECT_GT(r.baseline_kib, 0);
-  EXPECT_TRUE(failures(c, r, 4.0).empty());
+  EXPECT_TRUE(counted_failures(c, r).empty());
 }
 
 TEST(SoakHarness, SeesALeak) {
+  if (!kMemoryMeasurable) GTEST_SKIP() << "resident memory is not measurable under ASan";
   const Config c = short_config();
   // 64 KiB kept per frame, touched so that it is resident: 300 frames after the warm-up leak
   // ~19 MiB; the quarter means of the samples (150..400) are ~200 frames = ~12 MiB apart.
@@ -64,7 +82,7 @@ TEST(SoakHarness, SeesALostFrame) {
   EXPECT_EQ(r.out_of_order, c.frames - 150);
   // The pipeline counts the gap in the indices as a dropped frame too.
   EXPECT_EQ(r.dropped, 1);
-  const auto why = failures(c, r, 4.0);
+  const auto why = counted_failures(c, r);
   ASSERT_EQ(why.size(), 2u);
   EXPECT_NE(why[0].find("out of order"), std::string::npos) << why[0];
   EXPECT_NE(why[1].find("dropped 1"), std::string::npos) << why[1];
