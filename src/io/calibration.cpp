@@ -183,6 +183,13 @@ EurocCamera read_euroc_camera(const fs::path& path) {
   const auto d = yaml_numbers(root, "distortion_coefficients", path, 0);
   cam.D = cv::Mat(d, true).reshape(1, 1);
   const auto res = yaml_numbers(root, "resolution", path, 2);
+  for (const double v : res) {
+    // Checked before the cast: a double beyond int's range is undefined behaviour as an int.
+    if (!(v >= 1.0 && v <= 100000.0 && v == std::floor(v))) {
+      throw core::InputError(path.string() +
+                             ": resolution must be two whole numbers of pixels in 1..100000");
+    }
+  }
   cam.size = cv::Size(static_cast<int>(res[0]), static_cast<int>(res[1]));
   if (!root["T_BS"] || !root["T_BS"].IsMap()) {
     throw core::InputError(path.string() + ": missing field 'T_BS' (a 4x4 matrix with data:)");

@@ -177,5 +177,20 @@ TEST(FuzzFindings, GtImageThatIsNotPngOrPgmIsRefusedBeforeDecoding) {
                        "GT disparity is not a PNG or PGM image"));
 }
 
+// fuzz_euroc_calib: `resolution: [5.6e34, 48]` was cast to int (UBSan float-cast-overflow).
+TEST(FuzzFindings, EurocResolutionBeyondIntIsAnInputError) {
+  ScratchDir dir;
+  const std::string rest =
+      "T_BS:\n  cols: 4\n  rows: 4\n  data: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"
+      "rate_hz: 20\nintrinsics: [50, 50, 32, 24]\ndistortion_coefficients: [0, 0, 0, 0]\n";
+  std::ofstream(dir.path() / "left.yaml") << rest << "resolution: [5.6e34, 48]\n";
+  std::ofstream(dir.path() / "right.yaml") << rest << "resolution: [64, 48]\n";
+  EXPECT_TRUE(contains(input_error_of([&] {
+                         read_euroc_calibration(dir.path() / "left.yaml",
+                                                dir.path() / "right.yaml");
+                       }),
+                       "resolution must be two whole numbers"));
+}
+
 }  // namespace
 }  // namespace sg::io
