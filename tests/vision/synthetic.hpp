@@ -3,7 +3,22 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "sg/core/camera.hpp"
+
 namespace sg::vision::test {
+
+/// A small camera for hand-made maps: f*B = 50 px*m, 10 fps, 161 x 121.
+inline core::Camera camera() {
+  core::Camera c;
+  c.width = 161;
+  c.height = 121;
+  c.focal_px = 100.0;
+  c.baseline_m = 0.5;
+  c.cx = 80.0;
+  c.cy = 60.0;
+  c.fps = 10.0;
+  return c;
+}
 
 /// Smooth random texture (blurred uniform noise, full 0..255 range), fixed seed.
 inline cv::Mat texture(cv::Size size, uint64_t seed, double sigma = 1.0) {

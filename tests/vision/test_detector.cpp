@@ -11,18 +11,7 @@
 namespace sg::vision {
 namespace {
 
-/// f*B = 50 px*m, 10 fps, 161 x 121.
-core::Camera camera() {
-  core::Camera c;
-  c.width = 161;
-  c.height = 121;
-  c.focal_px = 100.0;
-  c.baseline_m = 0.5;
-  c.cx = 80.0;
-  c.cy = 60.0;
-  c.fps = 10.0;
-  return c;
-}
+using test::camera;
 
 const cv::Rect kPatch(60, 45, 60, 31);  // centre columns [53,107) and 13 columns of the right
 

@@ -6,22 +6,12 @@
 #include "sg/core/error.hpp"
 #include "sg/vision/scene_flow.hpp"
 #include "sg/vision/segment_motion.hpp"
+#include "synthetic.hpp"
 
 namespace sg::vision {
 namespace {
 
-/// f*B = 50 px*m, 161 x 121.
-core::Camera camera() {
-  core::Camera c;
-  c.width = 161;
-  c.height = 121;
-  c.focal_px = 100.0;
-  c.baseline_m = 0.5;
-  c.cx = 80.0;
-  c.cy = 60.0;
-  c.fps = 10.0;
-  return c;
-}
+using test::camera;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
