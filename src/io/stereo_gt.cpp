@@ -1,9 +1,11 @@
 #include "sg/io/stereo_gt.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -100,10 +102,90 @@ void pairs_in(const fs::path& dir, double scale, std::vector<StereoGtPair>& out)
   }
 }
 
-/// cv::imread picks its decoder by content, not by name: a 22-byte OpenEXR header named
-/// disp2.png kept it busy for seconds (found by fuzz_stereo_gt). GT images are PNG (or PGM, as
-/// some Middlebury 2001 files are); anything else is refused before decoding.
-void check_gt_image_signature(const fs::path& path) {
+/// Skips whitespace and '#' comments of a PGM header from `at`; the offset of the next token.
+size_t skip_pgm_space(const std::string& bytes, size_t at) {
+  while (at < bytes.size()) {
+    if (bytes[at] == '#') {
+      while (at < bytes.size() && bytes[at] != '\n') ++at;
+    } else if (std::isspace(static_cast<unsigned char>(bytes[at]))) {
+      ++at;
+    } else {
+      break;
+    }
+  }
+  return at;
+}
+
+/// Reads a decimal header field of at most 6 digits at `at` (after skip_pgm_space); -1 if none.
+long pgm_number(const std::string& bytes, size_t& at) {
+  at = skip_pgm_space(bytes, at);
+  long value = 0;
+  int digits = 0;
+  while (at < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[at])) && digits < 7) {
+    value = value * 10 + (bytes[at++] - '0');
+    ++digits;
+  }
+  return digits == 0 || digits > 6 ? -1 : value;
+}
+
+/// A binary (P5) or ASCII (P2) PGM, parsed here rather than by cv::imread: imread picks its
+/// decoder by content, and a file that starts like a PGM can carry another format's mark too
+/// ("DICM" at byte 128 sent one to the GDCM decoder, which aborted; found by fuzz_stereo_gt).
+/// CV_8U for maxval <= 255, else CV_16U (big-endian samples, as the format says).
+cv::Mat read_pgm(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError("cannot read GT disparity " + path.string());
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto bad = [&](const std::string& why) {
+    return core::InputError(path.string() + ": not a valid PGM image (" + why + ")");
+  };
+  const bool ascii = bytes.size() >= 2 && bytes[1] == '2';
+  size_t at = 2;
+  if (at >= bytes.size() || !std::isspace(static_cast<unsigned char>(bytes[at])))
+    throw bad("no whitespace after the magic number");
+  const long width = pgm_number(bytes, at), height = pgm_number(bytes, at);
+  const long maxval = pgm_number(bytes, at);
+  if (width < 1 || height < 1 || width > 65536 || height > 65536)
+    throw bad("width and height must be whole numbers in 1..65536");
+  if (maxval < 1 || maxval > 65535) throw bad("maxval must be in 1..65535");
+  if (at >= bytes.size() || !std::isspace(static_cast<unsigned char>(bytes[at])))
+    throw bad("no whitespace after maxval");
+  ++at;
+  const size_t samples = static_cast<size_t>(width) * static_cast<size_t>(height);
+  const int sample_bytes = maxval > 255 ? 2 : 1;
+  // The header alone must not make us allocate: every sample needs at least one byte.
+  const size_t needed = ascii ? 2 * samples - 1 : samples * sample_bytes;
+  if (bytes.size() - at < needed) throw bad("truncated: " + std::to_string(samples) + " samples");
+  cv::Mat out(static_cast<int>(height), static_cast<int>(width),
+              sample_bytes == 2 ? CV_16U : CV_8U);
+  for (size_t i = 0; i < samples; ++i) {
+    long v = 0;
+    if (ascii) {
+      v = pgm_number(bytes, at);
+      if (v < 0) throw bad("sample " + std::to_string(i) + " is not a number");
+    } else if (sample_bytes == 2) {
+      v = static_cast<unsigned char>(bytes[at]) << 8 | static_cast<unsigned char>(bytes[at + 1]);
+      at += 2;
+    } else {
+      v = static_cast<unsigned char>(bytes[at++]);
+    }
+    if (v > maxval) throw bad("sample " + std::to_string(i) + " exceeds maxval");
+    const int y = static_cast<int>(i / static_cast<size_t>(width));
+    const int x = static_cast<int>(i % static_cast<size_t>(width));
+    if (sample_bytes == 2) {
+      out.at<std::uint16_t>(y, x) = static_cast<std::uint16_t>(v);
+    } else {
+      out.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(v);
+    }
+  }
+  return out;
+}
+
+/// A GT disparity image: PNG (decoded by cv::imread) or PGM (read_pgm), as some Middlebury
+/// 2001 files are. cv::imread picks its decoder by content, not by name (a 22-byte OpenEXR
+/// header named disp2.png kept it busy for seconds, found by fuzz_stereo_gt), so anything else
+/// is refused before decoding.
+cv::Mat read_gt_image(const fs::path& path) {
   static constexpr unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   unsigned char head[sizeof kPng] = {};
   std::ifstream in(path, std::ios::binary);
@@ -111,9 +193,11 @@ void check_gt_image_signature(const fs::path& path) {
   in.read(reinterpret_cast<char*>(head), sizeof head);
   const bool png = in.gcount() == sizeof head && std::memcmp(head, kPng, sizeof head) == 0;
   const bool pgm = in.gcount() >= 2 && head[0] == 'P' && (head[1] == '2' || head[1] == '5');
-  if (!png && !pgm) {
-    throw core::InputError(path.string() + ": GT disparity is not a PNG or PGM image");
-  }
+  if (pgm) return read_pgm(path);
+  if (!png) throw core::InputError(path.string() + ": GT disparity is not a PNG or PGM image");
+  cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  if (raw.empty()) throw core::InputError("cannot read GT disparity " + path.string());
+  return raw;
 }
 
 }  // namespace
@@ -176,9 +260,7 @@ void write_pfm(const fs::path& path, const cv::Mat& disparity) {
 
 cv::Mat read_middlebury_png(const fs::path& path, double scale) {
   if (!(scale > 0)) throw core::InputError("gt_scale=" + std::to_string(scale) + ": must be > 0");
-  check_gt_image_signature(path);
-  cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  if (raw.empty()) throw core::InputError("cannot read GT disparity " + path.string());
+  cv::Mat raw = read_gt_image(path);
   if (raw.depth() != CV_8U)
     throw core::InputError(path.string() + ": Middlebury GT must be an 8-bit PNG");
   if (raw.channels() != 1) cv::extractChannel(raw, raw, 0);
@@ -189,9 +271,7 @@ cv::Mat read_middlebury_png(const fs::path& path, double scale) {
 
 cv::Mat read_stereo_gt(const fs::path& path, double scale) {
   if (path.extension() == ".pfm") return read_pfm(path);
-  check_gt_image_signature(path);
-  cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  if (raw.empty()) throw core::InputError("cannot read GT disparity " + path.string());
+  cv::Mat raw = read_gt_image(path);
   if (raw.depth() == CV_16U) return read_disparity_png(path);
   if (!(scale > 0)) {
     throw core::InputError(path.string() +

@@ -192,5 +192,25 @@ TEST(FuzzFindings, EurocResolutionBeyondIntIsAnInputError) {
                        "resolution must be two whole numbers"));
 }
 
+// fuzz_stereo_gt: a file that starts like a PGM ("P2") but holds DICOM's "DICM" mark at byte
+// 128 went to OpenCV's GDCM decoder, which aborted the process. PGMs are parsed by us now.
+TEST(FuzzFindings, PgmWithADicomMarkIsAnInputErrorNotADecoderAbort) {
+  ScratchDir dir;
+  std::string bytes = "P2\x15\x15\x15\x01";
+  bytes.resize(128, '\0');
+  bytes += "DICM\x15\x15\n";
+  std::ofstream(dir.path() / "disp2.png", std::ios::binary) << bytes;
+  const std::string message =
+      input_error_of([&] { read_stereo_gt(dir.path() / "disp2.png", 4.0); });
+  EXPECT_TRUE(contains(message, "not a valid PGM image")) << message;
+  // Headers announcing more samples than the file holds, or samples above maxval, are refused.
+  std::ofstream(dir.path() / "big.pgm", std::ios::binary) << "P5 65536 65536 255\n";
+  EXPECT_TRUE(
+      contains(input_error_of([&] { read_stereo_gt(dir.path() / "big.pgm", 1.0); }), "truncated"));
+  std::ofstream(dir.path() / "over.pgm", std::ios::binary) << "P2 2 1 10\n3 11\n";
+  EXPECT_TRUE(contains(input_error_of([&] { read_stereo_gt(dir.path() / "over.pgm", 1.0); }),
+                       "exceeds maxval"));
+}
+
 }  // namespace
 }  // namespace sg::io

@@ -69,6 +69,24 @@ TEST(StereoGt, MiddleburyPngIsDividedByItsScale) {
             std::string::npos);
 }
 
+TEST(StereoGt, PgmBinaryAndAsciiWithACommentAreRead) {
+  ScratchDir dir;
+  // Binary 3x1 with a comment in the header; ASCII 2x2 across lines.
+  std::ofstream(dir.path() / "bin.pgm", std::ios::binary) << "P5\n# Middlebury\n3 1\n255\n"
+                                                          << std::string("\x00\x08\xff", 3);
+  const cv::Mat b = read_stereo_gt(dir.path() / "bin.pgm", 8.0);
+  ASSERT_EQ(b.size(), cv::Size(3, 1));
+  EXPECT_EQ(b.at<float>(0, 0), 0.0f);
+  EXPECT_EQ(b.at<float>(0, 1), 1.0f);
+  EXPECT_EQ(b.at<float>(0, 2), 255.0f / 8);
+  std::ofstream(dir.path() / "ascii.pgm") << "P2 2 2 200\n4 8\n12\n200\n";
+  const cv::Mat a = read_stereo_gt(dir.path() / "ascii.pgm", 4.0);
+  ASSERT_EQ(a.size(), cv::Size(2, 2));
+  EXPECT_EQ(a.at<float>(0, 1), 2.0f);
+  EXPECT_EQ(a.at<float>(1, 0), 3.0f);
+  EXPECT_EQ(a.at<float>(1, 1), 50.0f);
+}
+
 TEST(StereoGt, KittiPngIsDividedBy256) {
   ScratchDir dir;
   cv::Mat v(1, 2, CV_16U);
