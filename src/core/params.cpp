@@ -131,6 +131,9 @@ std::vector<std::string> validate(const SignalParams& p) {
             "must be > 0");
   c.require(p.ttc_fit_min_frames >= 2, "ttc_fit_min_frames", p.ttc_fit_min_frames,
             "must be >= 2");
+  c.require(std::isfinite(p.ttc_fit_min_span_s) && p.ttc_fit_min_span_s >= 0 &&
+                p.ttc_fit_min_span_s <= p.ttc_fit_window_s,
+            "ttc_fit_min_span_s", p.ttc_fit_min_span_s, "must be in [0, ttc_fit_window_s]");
   c.require(p.severity_off_frames >= 1, "severity_off_frames", p.severity_off_frames,
             "must be >= 1");
   return out;

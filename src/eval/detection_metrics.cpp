@@ -55,7 +55,12 @@ void DetectionEvaluator::add(const core::Detection& detection, const core::Frame
                                      o.bbox & cv::Rect(0, 0, gt_danger.cols, gt_danger.rows)));
       if (!best || score > best_score) best = &o, best_score = score;
     }
-    if (best) ttc_errors_.push_back(std::abs(*best->ttc_s - *gt->ttc_s) / *gt->ttc_s);
+    if (best) {
+      const double error = std::abs(*best->ttc_s - *gt->ttc_s) / *gt->ttc_s;
+      ttc_errors_.push_back(error);
+      if (run_length_ > DetectionReport::kTtcSettleFrames)
+        ttc_error_max_settled_ = std::max(ttc_error_max_settled_.value_or(0.0), error);
+    }
   }
   if (frames_ > 1 && detection.severity != last_severity_) ++severity_changes_;
   last_severity_ = detection.severity;
@@ -91,6 +96,7 @@ DetectionReport DetectionEvaluator::report() const {
     r.ttc_rel_error_median = at(0.5);
     r.ttc_rel_error_p90 = at(0.9);
   }
+  r.ttc_rel_error_max_settled = ttc_error_max_settled_;
   r.severity_changes = severity_changes_;
   return r;
 }
@@ -116,6 +122,7 @@ nlohmann::json DetectionReport::to_json() const {
           {"ttc_frames", ttc_frames},
           {"ttc_rel_error_median", opt(ttc_rel_error_median)},
           {"ttc_rel_error_p90", opt(ttc_rel_error_p90)},
+          {"ttc_rel_error_max_settled", opt(ttc_rel_error_max_settled)},
           {"severity_changes", severity_changes},
           {"first_alarm_frame",
            first_alarm_frame ? nlohmann::json(*first_alarm_frame) : nlohmann::json()}};
@@ -134,7 +141,10 @@ std::string DetectionReport::table() const {
     << "  danger IoU        " << danger_iou << "\n";
   if (ttc_rel_error_median) {
     s << "  TTC rel. error    median " << *ttc_rel_error_median << "  p90 " << *ttc_rel_error_p90
-      << " (" << ttc_frames << " frames)\n";
+      << " (" << ttc_frames << " frames)";
+    if (ttc_rel_error_max_settled)
+      s << "  max after " << kTtcSettleFrames << " frames " << *ttc_rel_error_max_settled;
+    s << "\n";
   }
   s << "  severity changes  " << severity_changes << "\n";
   s << std::setprecision(2);

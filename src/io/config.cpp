@@ -152,6 +152,8 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("track_min_overlap", p.signal.track_min_overlap)
         .field("ttc_fit_window_s", p.signal.ttc_fit_window_s)
         .field("ttc_fit_min_frames", p.signal.ttc_fit_min_frames)
+        .field("ttc_fit_min_span_s", p.signal.ttc_fit_min_span_s)
+        .field("coast_near_range", p.signal.coast_near_range)
         .field("severity_off_frames", p.signal.severity_off_frames)
         .done();
     std::string method = core::to_string(p.flow.method);

@@ -41,6 +41,7 @@ nlohmann::json detection_to_json(const core::Detection& d, bool timing) {
     }
     if (o.track_id > 0) e["id"] = o.track_id;
     if (o.closing_speed_mps) e["closing_speed_mps"] = rounded(*o.closing_speed_mps, 4);
+    if (o.predicted) e["predicted"] = true;
     j["obstacles"].push_back(std::move(e));
   }
   if (timing) j["latency_ms"] = rounded(d.latency_ms, 3);

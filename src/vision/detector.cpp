@@ -40,7 +40,8 @@ Detector::Detector(const core::DetectorParams& params, const core::Camera& camer
     : params_(params),
       camera_(camera),
       hysteresis_(params.signal),
-      tracker_(params.signal, params.envelope.z_contact_m),
+      tracker_(params.signal, params.envelope.z_contact_m,
+               camera.focal_px * camera.baseline_m / std::max(1, params.bm.num_disparities - 1)),
       severity_(params.signal) {
   const std::vector<int>& gaps =
       params_.mode == core::Mode::kStereoFlow ? params_.scene_flow.gaps : params_.stereo.gaps;
@@ -151,6 +152,15 @@ core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) 
   det.danger = job.danger_;
   det.obstacles = std::move(job.obstacles_);
   tracker_.update(det.time_s, det.obstacles);
+  // An obstacle kept by prediction after its blob vanished nearer than the matcher sees is
+  // dangerous where it was last seen.
+  bool painted = false;
+  for (const core::Obstacle& o : det.obstacles)
+    if (o.predicted && o.pixels == 0) {
+      det.danger(o.bbox & cv::Rect(0, 0, det.danger.cols, det.danger.rows)).setTo(255);
+      painted = true;
+    }
+  if (painted) job.region_pixels_ = count_region_pixels(det.danger, params_.signal.region_columns);
   det.regions = hysteresis_.update(job.region_pixels_);
   det.signal = std::any_of(det.regions.begin(), det.regions.end(),
                            [](const core::RegionSignal& r) { return r.fired; });

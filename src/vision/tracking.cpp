@@ -31,16 +31,37 @@ bool fit_line(const std::vector<double>& t, const std::vector<double>& z, double
   return true;
 }
 
-ObstacleTracker::ObstacleTracker(const core::SignalParams& p, double z_contact_m)
-    : p_(p), z_contact_m_(z_contact_m) {}
+ObstacleTracker::ObstacleTracker(const core::SignalParams& p, double z_contact_m,
+                                 double z_near_limit_m)
+    : p_(p), z_contact_m_(z_contact_m), z_near_limit_m_(z_near_limit_m) {}
+
+bool ObstacleTracker::out_of_reach(const Track& track, double time_s) const {
+  double z_now = 0;
+  return p_.coast_near_range && track.predict(time_s, z_now) && track.fit_rate < -kMinClosingMps &&
+         z_now < kNearRangeMargin * z_near_limit_m_;
+}
+
+void ObstacleTracker::set_from_fit(double z_now, double rate, core::Obstacle& o) const {
+  o.distance_m = z_now;
+  o.closing_speed_mps = -rate;
+  if (z_now <= z_contact_m_) {
+    o.ttc_s = 0.0;
+  } else if (-rate > kMinClosingMps) {
+    o.ttc_s = (z_now - z_contact_m_) / -rate;
+  } else {
+    o.ttc_s.reset();
+  }
+}
 
 void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacles) {
-  // Every (likeness, track, obstacle) pair that overlaps enough, most alike first. A pair
-  // overlaps enough when the intersection covers track_min_overlap of the smaller box; it is
-  // ranked by intersection over union, so that when a blob splits (noise cuts a fragment off)
-  // its track goes on with the main part, not with a fragment lying inside its old box, which
-  // would restart the main part's TTC fit.
-  std::vector<std::tuple<double, size_t, size_t>> pairs;
+  // Every (age, likeness, track, obstacle) pair that overlaps enough, oldest track first, then
+  // most alike. A pair overlaps enough when the intersection covers track_min_overlap of the
+  // smaller box. Among the blobs of one track the one most like it by intersection over union
+  // wins, so that when a blob splits (noise cuts a fragment off) its track goes on with the main
+  // part, not with a fragment lying inside its old box, which would restart the main part's TTC
+  // fit. Among the tracks of one blob the oldest wins: when the fragments of a thin pole merge
+  // again, the blob keeps the longest history, not the fragment's that happens to fit its box best.
+  std::vector<std::tuple<double, double, size_t, size_t>> pairs;
   for (size_t k = 0; k < tracks_.size(); ++k)
     for (size_t j = 0; j < obstacles.size(); ++j) {
       const cv::Rect& a = tracks_[k].bbox;
@@ -49,13 +70,15 @@ void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacl
       if (smaller <= 0) continue;
       const double common = (a & b).area();
       if (common / smaller >= p_.track_min_overlap)
-        pairs.emplace_back(common / (a.area() + b.area() - common), k, j);
+        pairs.emplace_back(tracks_[k].first_s, common / (a.area() + b.area() - common), k, j);
     }
-  std::sort(pairs.begin(), pairs.end(),
-            [](const auto& x, const auto& y) { return std::get<0>(x) > std::get<0>(y); });
+  std::sort(pairs.begin(), pairs.end(), [](const auto& x, const auto& y) {
+    if (std::get<0>(x) != std::get<0>(y)) return std::get<0>(x) < std::get<0>(y);
+    return std::get<1>(x) > std::get<1>(y);
+  });
   std::vector<int> track_of(obstacles.size(), -1);
   std::vector<bool> taken(tracks_.size(), false);
-  for (const auto& [overlap, k, j] : pairs) {
+  for (const auto& [since, overlap, k, j] : pairs) {
     if (taken[k] || track_of[j] >= 0) continue;
     taken[k] = true;
     track_of[j] = static_cast<int>(k);
@@ -68,8 +91,19 @@ void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacl
       track = std::move(tracks_[static_cast<size_t>(track_of[j])]);
     } else {
       track.id = next_id_++;
+      track.first_s = time_s;
     }
     track.bbox = o.bbox;
+    o.track_id = track.id;
+    if (out_of_reach(track, time_s)) {
+      // Its disparity is beyond the matcher's range: the measurement is not the obstacle's.
+      double z_now = 0;
+      track.predict(time_s, z_now);
+      set_from_fit(z_now, track.fit_rate, o);
+      o.predicted = true;
+      next.push_back(std::move(track));
+      continue;
+    }
     if (o.distance_m > 0) {
       track.t.push_back(time_s);
       track.z.push_back(o.distance_m);
@@ -78,20 +112,31 @@ void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacl
       track.t.pop_front();
       track.z.pop_front();
     }
-    o.track_id = track.id;
     double z_now = 0, rate = 0;
     if (static_cast<int>(track.t.size()) >= p_.ttc_fit_min_frames &&
+        track.t.back() - track.t.front() >= p_.ttc_fit_min_span_s - 1e-9 &&
         fit_line({track.t.begin(), track.t.end()}, {track.z.begin(), track.z.end()}, z_now, rate)) {
-      o.distance_m = z_now;
-      o.closing_speed_mps = -rate;
-      if (z_now <= z_contact_m_) {
-        o.ttc_s = 0.0;
-      } else if (-rate > kMinClosingMps) {
-        o.ttc_s = (z_now - z_contact_m_) / -rate;
-      } else {
-        o.ttc_s.reset();
-      }
+      set_from_fit(z_now, rate, o);
+      track.fitted = true;
+      track.fit_t = track.t.back();
+      track.fit_z = z_now;
+      track.fit_rate = rate;
     }
+    next.push_back(std::move(track));
+  }
+  // Tracks whose blob vanished where the matcher cannot see it go on by prediction until contact.
+  for (size_t k = 0; k < tracks_.size(); ++k) {
+    Track& track = tracks_[k];
+    if (taken[k] || !out_of_reach(track, time_s)) continue;
+    core::Obstacle o;
+    double z_now = 0;
+    track.predict(time_s, z_now);
+    set_from_fit(z_now, track.fit_rate, o);
+    if (!o.ttc_s || *o.ttc_s <= 0.0) continue;  // contact reached: the track ends
+    o.bbox = track.bbox;
+    o.track_id = track.id;
+    o.predicted = true;
+    obstacles.push_back(o);
     next.push_back(std::move(track));
   }
   tracks_ = std::move(next);

@@ -57,6 +57,30 @@ TEST(DetectionMetrics, SettledRecallRestartsWithEachRun) {
   EXPECT_DOUBLE_EQ(r.recall, 0.25);
 }
 
+TEST(DetectionMetrics, TtcErrorsMedianP90AndMaxAfterTheFirstFiveFramesOfARun) {
+  // A 10-frame GT alarm run, GT TTC 2.0 s; the detected TTC is off by 50 % on frame 1 (inside
+  // the first 5 frames), by 20 % on frame 7 and exact elsewhere; frame 3 has no TTC at all.
+  DetectionEvaluator ev(3);
+  for (int i = 0; i < 10; ++i) {
+    core::Detection d = detection(i, true);
+    d.severity = i < 6 ? core::Severity::kWarning : core::Severity::kDanger;
+    if (i != 3) {
+      core::Obstacle o;
+      o.bbox = cv::Rect(0, 0, 4, 4);
+      o.ttc_s = i == 1 ? 3.0 : i == 7 ? 1.6 : 2.0;
+      d.obstacles.push_back(o);
+    }
+    ev.add(d, truth(i, true, 2.0), cv::Mat());
+  }
+  const DetectionReport r = ev.report();
+  EXPECT_EQ(r.ttc_frames, 9);
+  ASSERT_TRUE(r.ttc_rel_error_median && r.ttc_rel_error_p90 && r.ttc_rel_error_max_settled);
+  EXPECT_DOUBLE_EQ(*r.ttc_rel_error_median, 0.0);
+  EXPECT_NEAR(*r.ttc_rel_error_p90, 0.5, 1e-12);          // nearest rank 9 of the 9 errors
+  EXPECT_NEAR(*r.ttc_rel_error_max_settled, 0.2, 1e-12);  // frame 1's 0.5 is not settled
+  EXPECT_EQ(r.severity_changes, 1);                       // warning -> danger at frame 6
+}
+
 TEST(DetectionMetrics, NeverAlarmedObstacleHasNoLeadTime) {
   DetectionEvaluator ev;
   for (int i = 0; i < 5; ++i) ev.add(detection(i, false), truth(i, true, 2.0), cv::Mat());

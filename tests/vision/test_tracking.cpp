@@ -74,6 +74,7 @@ TEST(ObstacleTracker, FittedTtcFollowsTheTruthThroughNoiseAndDrops) {
 // the fragment lies wholly inside the old box and the main part, shifted, only mostly.
 TEST(ObstacleTracker, SplitBlobKeepsItsTrackOnTheMainPart) {
   core::SignalParams p;
+  p.ttc_fit_min_span_s = 0.0;  // fit the seven frames (0.2 s) below
   ObstacleTracker tracker(p, 0.5);
   std::vector<core::Obstacle> obs;
   for (int i = 0; i < 6; ++i) {
@@ -89,6 +90,91 @@ TEST(ObstacleTracker, SplitBlobKeepsItsTrackOnTheMainPart) {
   // The main part's fit still spans the seven frames: 3 m/s.
   ASSERT_TRUE(obs[0].closing_speed_mps);
   EXPECT_NEAR(*obs[0].closing_speed_mps, 3.0, 1e-6);
+}
+
+// The fit waits until its samples span ttc_fit_min_span_s: before, the blob's own TTC stands.
+TEST(ObstacleTracker, FitWaitsForItsMinimumSpan) {
+  core::SignalParams p;
+  p.ttc_fit_min_frames = 4;
+  p.ttc_fit_min_span_s = 0.5;
+  ObstacleTracker tracker(p, 0.5);
+  for (int i = 0; i <= 20; ++i) {
+    const double t = i / 30.0;
+    std::vector<core::Obstacle> obs{box_at(cv::Rect(100, 100, 40, 40), 10.0 - 2.0 * t, 7.7)};
+    tracker.update(t, obs);
+    if (i < 15) {  // 14 frames span 0.467 s
+      EXPECT_FALSE(obs[0].closing_speed_mps) << i;
+      EXPECT_DOUBLE_EQ(*obs[0].ttc_s, 7.7) << i;
+    } else {
+      ASSERT_TRUE(obs[0].closing_speed_mps) << i;
+      EXPECT_NEAR(*obs[0].ttc_s, (10.0 - 2.0 * t - 0.5) / 2.0, 1e-9) << i;
+    }
+  }
+}
+
+// Fragments of one thin object that merge again: the merged blob goes on with the oldest track,
+// though a younger fragment's box is more like it.
+TEST(ObstacleTracker, MergedFragmentsKeepTheOldestTrack) {
+  core::SignalParams p;
+  ObstacleTracker tracker(p, 0.5);
+  std::vector<core::Obstacle> obs{box_at(cv::Rect(100, 0, 10, 40), 5.0, 3.0)};
+  tracker.update(0.0, obs);
+  const int old_id = obs[0].track_id;
+  obs = {box_at(cv::Rect(100, 0, 10, 40), 5.0, 3.0), box_at(cv::Rect(100, 50, 12, 150), 5.0, 3.0)};
+  tracker.update(1 / 30.0, obs);
+  ASSERT_EQ(obs[0].track_id, old_id);
+  obs = {box_at(cv::Rect(100, 0, 12, 200), 4.9, 3.0)};
+  tracker.update(2 / 30.0, obs);
+  EXPECT_EQ(obs[0].track_id, old_id);
+}
+
+// A pole approached at 1.4 m/s: its blob is measured down to 1.0 m and then vanishes, as when its
+// disparity leaves the matcher's range (near limit 0.95 m). The track goes on by prediction, its
+// last box dangerous, with the true TTC, until contact; without coast_near_range it ends at once.
+TEST(ObstacleTracker, TrackNearerThanTheMatcherSeesCoastsUntilContact) {
+  for (const bool coast : {true, false}) {
+    core::SignalParams p;
+    p.coast_near_range = coast;
+    const double z_contact = 0.4, near_limit = 0.95, speed = 1.4;
+    ObstacleTracker tracker(p, z_contact, near_limit);
+    const cv::Rect last_box(300, 50, 30, 400);
+    int id = 0, predicted_frames = 0, measured_near = 0;
+    for (int i = 0; i < 120; ++i) {
+      const double t = i / 30.0, z = 5.0 - speed * t;
+      if (z <= z_contact) break;
+      std::vector<core::Obstacle> obs;
+      // Measured down to 1.0 m; between 1.0 and 1.1 m with a wrong (aliased) distance of 3 m.
+      if (z > 1.1) obs.push_back(box_at(last_box, z, 9.0));
+      if (z <= 1.1 && z > 1.0) obs.push_back(box_at(last_box, 3.0, 9.0));
+      tracker.update(t, obs);
+      if (i == 0) id = obs[0].track_id;
+      if (z > 1.25 * near_limit) {
+        ASSERT_EQ(obs.size(), 1u);
+        EXPECT_FALSE(obs[0].predicted) << i;
+        continue;
+      }
+      if (!coast) {
+        if (z <= 1.0) EXPECT_TRUE(obs.empty()) << i;
+        continue;
+      }
+      ASSERT_EQ(obs.size(), 1u) << i << " z " << z;
+      EXPECT_EQ(obs[0].track_id, id);
+      EXPECT_TRUE(obs[0].predicted) << i;
+      EXPECT_NEAR(obs[0].distance_m, z, 1e-6) << i;
+      ASSERT_TRUE(obs[0].ttc_s);
+      EXPECT_NEAR(*obs[0].ttc_s, (z - z_contact) / speed, 1e-6) << i;
+      if (obs[0].pixels == 0) {
+        ++predicted_frames;
+        EXPECT_EQ(obs[0].bbox, last_box);
+      } else {
+        ++measured_near;
+      }
+    }
+    if (coast) {
+      EXPECT_GT(predicted_frames, 10);  // 1.0 m to 0.4 m at 1.4 m/s: 12 frames
+      EXPECT_GT(measured_near, 3);      // 1.19 m to 1.0 m: the aliased 3 m never enters the fit
+    }
+  }
 }
 
 TEST(SeverityHold, RisesAtOnceFallsAfterItsFrames) {

@@ -31,6 +31,10 @@ struct Obstacle {
   /// Speed at which the distance shrinks, m/s, from the fit over the track (vision/tracking.hpp);
   /// when set, distance_m and ttc_s come from that fit too.
   std::optional<double> closing_speed_mps;
+  /// distance_m and ttc_s are the track's prediction, not a measurement: the obstacle came nearer
+  /// than the matcher's disparity range reaches (vision/tracking.hpp, signal.coast_near_range).
+  /// pixels = 0 and bbox = the last measured box when its blob is no longer seen at all.
+  bool predicted = false;
 };
 
 struct Detection {

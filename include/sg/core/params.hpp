@@ -91,9 +91,19 @@ struct SignalParams {
   double track_min_overlap = 0.3;
   /// An obstacle's TTC, distance and closing speed come from a straight-line fit of its distance
   /// over the last ttc_fit_window_s seconds (> 0) once it has ttc_fit_min_frames frames (>= 2)
-  /// in it; before that the blob's median per-pixel TTC stands.
+  /// spanning at least ttc_fit_min_span_s seconds (>= 0, <= the window) in it; before that the
+  /// blob's median per-pixel TTC stands. A slope fitted over a few frames is noisier than the
+  /// per-pixel TTCs, which compare with frames up to the longest gap back (20 frames, 0.67 s):
+  /// on ego-wall a 4-frame fit read 3.5 s for a true 2.9 s.
   double ttc_fit_window_s = 1.0;
   int ttc_fit_min_frames = 4;
+  double ttc_fit_min_span_s = 0.5;
+  /// An obstacle whose fitted distance has come under the matcher's near limit (f B / (number of
+  /// disparities - 1)) cannot be measured any more: its blob shows a wrong, aliased disparity or
+  /// vanishes, a few frames before contact. With this on, such a track's distance and TTC are
+  /// extrapolated from its fit, and a track whose blob vanished there is kept (an obstacle marked
+  /// predicted, its last box dangerous) until its predicted contact.
+  bool coast_near_range = true;
   /// Severity rises at once but falls only after this many consecutive frames asked for less
   /// (>= 1), so that it does not flicker between warning and danger.
   int severity_off_frames = 5;

@@ -34,6 +34,10 @@ struct DetectionReport {
   /// nearest to contact. Median and 90th percentile (nearest rank); empty when no such frame.
   int ttc_frames = 0;
   std::optional<double> ttc_rel_error_median, ttc_rel_error_p90;
+  /// The largest of those errors after the first kTtcSettleFrames frames of each run of GT alarm
+  /// frames (the track's fit needs some frames); empty when no such frame.
+  std::optional<double> ttc_rel_error_max_settled;
+  static constexpr int kTtcSettleFrames = 5;
   /// Frames whose severity differs from the previous frame's (none -> warning -> danger is 2).
   int severity_changes = 0;
 
@@ -59,6 +63,7 @@ class DetectionEvaluator {
   std::optional<int> first_alarm_;
   std::map<int, std::optional<double>> lead_;
   std::vector<double> ttc_errors_;
+  std::optional<double> ttc_error_max_settled_;
   core::Severity last_severity_ = core::Severity::kNone;
   int severity_changes_ = 0;
 };

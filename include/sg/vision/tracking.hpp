@@ -20,25 +20,50 @@ bool fit_line(const std::vector<double>& t, const std::vector<double>& z, double
 /// track. Frames must come in time order; dropped frames are fine (the fit uses time stamps).
 class ObstacleTracker {
  public:
-  /// p must be valid; z_contact_m = the envelope's contact depth, m.
-  ObstacleTracker(const core::SignalParams& p, double z_contact_m);
+  /// p must be valid; z_contact_m = the envelope's contact depth, m; z_near_limit_m = the
+  /// nearest depth the matcher measures, f B / (number of disparities - 1), m.
+  ObstacleTracker(const core::SignalParams& p, double z_contact_m, double z_near_limit_m = 0.0);
 
   /// Matches `obstacles` (this frame's, at time_s) to the tracks of the previous frame: a pair
   /// matches when their boxes' intersection covers at least track_min_overlap of the smaller box,
   /// best pairs first; unmatched obstacles start tracks, unmatched tracks end. Sets track_id; for a
-  /// track with ttc_fit_min_frames samples within ttc_fit_window_s, distance_m = the fitted
+  /// track with ttc_fit_min_frames samples within ttc_fit_window_s spanning at least
+  /// ttc_fit_min_span_s, distance_m = the fitted
   /// distance now, closing_speed_mps = -slope, and ttc_s = (distance - z_contact) / closing speed
   /// (0 when already inside the contact depth; empty when closing slower than 1 cm/s).
+  /// With p.coast_near_range, a track whose fit predicts it nearer than kNearRangeMargin times
+  /// the near limit now is out of the matcher's reach: a matched obstacle takes the predicted
+  /// distance and TTC (predicted = true, its measured distance is not added to the fit), and an
+  /// unmatched track closing faster than 1 cm/s is appended to `obstacles` as a predicted one at
+  /// its last box until its predicted TTC reaches 0.
   void update(double time_s, std::vector<core::Obstacle>& obstacles);
+
+  /// A blob fades some frames before its disparity leaves the matcher's range (the block's
+  /// window straddles the limit, uniqueness fails): the near zone starts this far out.
+  static constexpr double kNearRangeMargin = 1.25;
 
  private:
   struct Track {
     int id = 0;
+    double first_s = 0.0;  ///< when the track started, s
     cv::Rect bbox;
     std::deque<double> t, z;  ///< samples of the measured (median) distance
+    bool fitted = false;      ///< the last fit: z(t) = fit_z + fit_rate (t - fit_t)
+    double fit_t = 0.0, fit_z = 0.0, fit_rate = 0.0;
+    /// Predicted distance at time_s; false without a fit.
+    bool predict(double time_s, double& z_now) const {
+      z_now = fit_z + fit_rate * (time_s - fit_t);
+      return fitted;
+    }
   };
+  /// True when `track` is predicted nearer than the matcher measures at time_s (coasting).
+  bool out_of_reach(const Track& track, double time_s) const;
+  /// Sets o's distance, closing speed and TTC from distance z_now and rate (m/s, < 0 closing).
+  void set_from_fit(double z_now, double rate, core::Obstacle& o) const;
+
   core::SignalParams p_;
   double z_contact_m_;
+  double z_near_limit_m_;
   std::vector<Track> tracks_;
   int next_id_ = 1;
 };
