@@ -16,6 +16,15 @@
 
 namespace sg::vision {
 
+/// Interquartile mean of v (reordered; not empty): the mean of the middle half, ranks
+/// [n/4, n - n/4) of the sorted values. Robust like the median to the pixels paired across an
+/// occlusion, but not stuck to the 1/16 px grid of the matcher's disparities as a median of nearly
+/// equal quantized values is (at 19 m the disparity grows by 0.55 px over 20 frames: a 1/32 px
+/// offset is a 6 % TTC error). Two selections instead of a sort, O(n): a surface can be the whole
+/// floor, and sorting it was a fifth of a Stereo-Flow run on EuRoC. Summed in another order than
+/// the sorted one, so it may differ from that by a float rounding (the test's reference sorts).
+float interquartile_mean(std::vector<float>& v);
+
 /// Relabels a Stereo-Flow frame with pooled velocities. Surfaces are the 8-connected components
 /// of the labelling's candidates: valid disparity (disp, CV_32F, invalid < 0) with Z <= p.z_max_m,
 /// off the depth-edge margin (`edges`, CV_8U, 255 = near a depth edge: depth_edges()) and, with
