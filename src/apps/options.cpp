@@ -117,7 +117,7 @@ std::string input_platform(const OpenedInput& input) {
 
 void add_detector_options(CLI::App& app, DetectorOptions& o) {
   app.add_option("--config", o.config, "YAML config file (flags given too override it)");
-  app.add_option("--mode", o.mode, "stereo (default) or stereo-flow");
+  app.add_option("--mode", o.mode, "stereo-flow (default) or stereo");
   app.add_option("--num-disparities", o.num_disparities,
                  "stereo search range, px (positive multiple of 16; default 64)");
   app.add_option("--block-size", o.block_size, "stereo block size, px (odd, 5..255)");
@@ -157,6 +157,9 @@ pipeline::RunOptions make_run_options(const DetectorOptions& o,
   }
   if (o.platform) platform = *o.platform;
   core::apply_platform(platform, run.params);
+  // run and eval recommend Stereo-Flow: Stereo mode alarms on whatever passes by (crossing,
+  // ego-pass, turning). A config file's detector.mode or --mode picks the other.
+  run.params.mode = core::Mode::kStereoFlow;
   if (!o.config.empty()) io::apply_config_file(o.config, run.params, settings);
   if (settings_out) *settings_out = settings;
   run.pace_fps = settings.pace_fps;

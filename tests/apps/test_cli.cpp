@@ -241,6 +241,25 @@ TEST_F(Cli, ScenarioPlatformIsAppliedUnlessAFlagOrConfigSaysOtherwise) {
                     "num_disparities=256");  // flags still override the preset
 }
 
+// run and eval default to Stereo-Flow (the mode we recommend); a config file or --mode picks
+// Stereo. The summary's configuration names the mode that ran.
+TEST_F(Cli, RunAndEvalDefaultToStereoFlowUnlessAConfigOrFlagSaysStereo) {
+  const fs::path scenario = small_scenario(3);
+  const auto mode_of = [&](const std::string& args) {
+    const Result r = run(args + " --scenario '" + scenario.string() + "' --summary s.json");
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(slurp(dir_ / "s.json"))["config"]["mode"].get<std::string>();
+  };
+  EXPECT_EQ(mode_of("run"), "stereo-flow");
+  EXPECT_EQ(mode_of("run --mode stereo"), "stereo");
+  std::ofstream(dir_ / "stereo.yaml") << "mode: stereo\n";
+  EXPECT_EQ(mode_of("run --config stereo.yaml"), "stereo");
+  EXPECT_EQ(mode_of("run --config stereo.yaml --mode stereo-flow"), "stereo-flow");
+  const Result r = run("eval --scenario '" + scenario.string() + "' --json e.json");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("stereo-flow"), std::string::npos) << r.out;
+}
+
 TEST_F(Cli, UnknownPlatform) {
   expect_user_error(run("run --scenario '" + small_scenario().string() + "' --platform boat"),
                     "unknown platform 'boat'");
