@@ -95,7 +95,12 @@ void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacl
     }
     track.bbox = o.bbox;
     o.track_id = track.id;
-    if (out_of_reach(track, time_s)) {
+    // A blob measured nearer than the margin has a disparity at the top of the search range,
+    // saturated or aliased: it does not enter the fit either.
+    const bool measured_near = p_.coast_near_range && o.distance_m > 0 &&
+                               o.distance_m < kNearRangeMargin * z_near_limit_m_;
+    if (out_of_reach(track, time_s) ||
+        (measured_near && track.fitted && track.fit_rate < -kMinClosingMps)) {
       // Its disparity is beyond the matcher's range: the measurement is not the obstacle's.
       double z_now = 0;
       track.predict(time_s, z_now);
@@ -104,7 +109,7 @@ void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacl
       next.push_back(std::move(track));
       continue;
     }
-    if (o.distance_m > 0) {
+    if (o.distance_m > 0 && !measured_near) {
       track.t.push_back(time_s);
       track.z.push_back(o.distance_m);
     }

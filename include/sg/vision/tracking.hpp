@@ -33,7 +33,8 @@ class ObstacleTracker {
   /// (0 when already inside the contact depth; empty when closing slower than 1 cm/s).
   /// With p.coast_near_range, a track whose fit predicts it nearer than kNearRangeMargin times
   /// the near limit now is out of the matcher's reach: a matched obstacle takes the predicted
-  /// distance and TTC (predicted = true, its measured distance is not added to the fit), and an
+  /// distance and TTC (predicted = true, its measured distance is not added to the fit; so does
+  /// one measured nearer than that, a saturated disparity, when its track closes in), and an
   /// unmatched track closing faster than 1 cm/s is appended to `obstacles` as a predicted one at
   /// its last box until its predicted TTC reaches 0.
   void update(double time_s, std::vector<core::Obstacle>& obstacles);
