@@ -14,6 +14,10 @@ int main(int argc, char** argv) {
   // (perf). Kept on the heap, freed maps are reused as they are.
   mallopt(M_MMAP_THRESHOLD, 32 << 20);  // glibc's largest allowed value
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
+  // One heap for every thread: a farm worker's maps then reuse the blocks other threads freed,
+  // and the heap run and eval touch before the first frame (RunOptions::prefault_heap). A few
+  // dozen large blocks a frame: no contention worth the per-thread arenas.
+  mallopt(M_ARENA_MAX, 1);
   CLI::App app{"stereoguard: obstacle warnings from a stereo camera"};
   app.require_subcommand(0, 1);
   sg::apps::add_run_command(app);

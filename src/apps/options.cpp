@@ -186,6 +186,7 @@ pipeline::RunOptions make_run_options(const DetectorOptions& o,
   if (o.tokens) run.tokens = *o.tokens;
   if (o.threads) run.threads = *o.threads;
   if (o.tile_flow) run.tile_flow = true;
+  run.prefault_heap = true;  // main() keeps freed blocks on one heap
   return run;
 }
 

@@ -205,6 +205,10 @@ std::vector<std::string> validate(const SceneFlowParams& p) {
   c.require(p.edge_margin_px >= 0 && p.edge_margin_px <= 50, "edge_margin_px", p.edge_margin_px,
             "must be in 0..50 (0 disables)");
   c.require(finite_positive(p.edge_step_px), "edge_step_px", p.edge_step_px, "must be > 0");
+  c.require(p.chain_stride >= 1 && p.chain_stride <= 8, "chain_stride", p.chain_stride,
+            "must be in 1..8 (1 follows every candidate)");
+  c.require(finite_positive(p.chain_stride_z_m), "chain_stride_z_m", p.chain_stride_z_m,
+            "must be > 0");
   if (p.exclude_ground) {
     std::vector<std::string> more = validate(p.ground);
     out.insert(out.end(), more.begin(), more.end());

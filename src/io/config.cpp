@@ -180,6 +180,8 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("edge_step_px", p.scene_flow.edge_step_px)
         .field("keep_thin_structures", p.scene_flow.keep_thin_structures)
         .field("pool_surface_motion", p.scene_flow.pool_surface_motion)
+        .field("chain_stride", p.scene_flow.chain_stride)
+        .field("chain_stride_z_m", p.scene_flow.chain_stride_z_m)
         .field("grow_into_edges", p.scene_flow.grow_into_edges)
         .field("compensate_rotation", p.scene_flow.compensate_rotation)
         .field("longest_gap_decides", p.scene_flow.longest_gap_decides)

@@ -13,6 +13,7 @@
 #include "sg/core/error.hpp"
 #include "sg/par/backend.hpp"
 #include "sg/par/farm.hpp"
+#include "sg/par/memory.hpp"
 #include "sg/par/metrics.hpp"
 #include "sg/par/tiles.hpp"
 #include "sg/vision/detector.hpp"
@@ -228,6 +229,21 @@ std::string format_ms(double v) {
 
 int effective_tokens(const RunOptions& o) { return o.tokens > 0 ? o.tokens : o.workers + 1; }
 
+std::size_t heap_estimate(const RunOptions& o, int width, int height) {
+  if (width <= 0 || height <= 0) return 0;
+  const bool flow = o.params.mode == core::Mode::kStereoFlow;
+  const std::vector<int>& gaps = flow ? o.params.scene_flow.gaps : o.params.stereo.gaps;
+  const int history = gaps.empty() ? 1 : *std::max_element(gaps.begin(), gaps.end());
+  // Kept per past frame: disparity (4 B/px), and flow (8) and depth edges (1) for Stereo-Flow.
+  const std::size_t kept = flow ? 13 : 4;
+  // In flight per frame: two gray images, disparity, flow, depth edges, danger, TTC, velocity,
+  // and the labelling's surface labels and candidates: about 48 B/px.
+  const std::size_t in_flight = 48;
+  const auto pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  return pixels * (kept * static_cast<std::size_t>(history) +
+                   in_flight * static_cast<std::size_t>(effective_tokens(o) + 1));
+}
+
 std::vector<std::string> validate(const RunOptions& o, const core::Camera& camera) {
   std::vector<std::string> out = core::validate(o.params, camera);
   auto require = [&out](bool ok, const std::string& what) {
@@ -268,6 +284,9 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   farm.tokens = s.tokens;
   farm.threads = options.threads;
 
+  if (options.prefault_heap) {
+    par::prefault_heap(heap_estimate(options, source.camera().width, source.camera().height));
+  }
   Emitter emitter(source, options.pace_fps);
   par::LatencyStats latency;
   const par::TimePoint start = par::now();

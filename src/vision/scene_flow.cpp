@@ -272,6 +272,12 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
   };
 
   const float d_min = static_cast<float>(cam.focal_px * cam.baseline_m / p.z_max_m);
+  // Nearer than chain_stride_z_m only every stride-th row and column is followed (pooling gives
+  // the others their surface's velocity); by absolute row, so tiles follow the same pixels.
+  const int stride = p.pool_surface_motion ? p.chain_stride : 1;
+  const float d_stride =
+      stride > 1 ? static_cast<float>(cam.focal_px * cam.baseline_m / p.chain_stride_z_m)
+                 : std::numeric_limits<float>::infinity();
   auto in_band = [&cam, &env](int y, float d) {
     const double Y = (y - cam.cy) * cam.baseline_m / d;  // (y - cy) * Z / f
     return Y >= env.y_top_m && Y <= env.y_bottom_m;
@@ -290,11 +296,13 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
     float* ttc_row = ttc.ptr<float>(y);
     cv::Vec3f* vel_row = velocity.ptr<cv::Vec3f>(y);
     live.clear();
+    const bool stride_row = y % stride == 0;
     for (int x = 0; x < disp_cur.cols; ++x) {
       danger_row[x] = 0;
       ttc_row[x] = kNaN;
       vel_row[x] = unknown;
       if (d_row[x] > 0.0f && d_row[x] >= d_min && edge_row[x] == 0 &&
+          (d_row[x] < d_stride || (stride_row && x % stride == 0)) &&
           (!p.use_envelope_band || in_band(y, d_row[x]))) {
         q[x] = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
         live.push_back(x);

@@ -2,6 +2,7 @@
 // overlap, empty stream, exceptions propagate, bounds respected; each run with the sequential
 // backend and with TBB at 1, 2 and 4 threads.
 #include <gtest/gtest.h>
+#include <oneapi/tbb/global_control.h>
 
 #include <algorithm>
 #include <atomic>
@@ -10,18 +11,17 @@
 #include <memory>
 #include <mutex>
 #include <numeric>
-#include <ostream>
 #include <optional>
+#include <ostream>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include <oneapi/tbb/global_control.h>
-
 #include "sg/par/backend.hpp"
 #include "sg/par/farm.hpp"
+#include "sg/par/memory.hpp"
 #include "sg/par/metrics.hpp"
 #include "sg/par/tiles.hpp"
 
@@ -688,6 +688,13 @@ TEST(ClockTest, ElapsedIsSignedMilliseconds) {
   EXPECT_GE(elapsed_ms(a, b), 0.0);  // monotonic
   Stopwatch watch;
   EXPECT_GE(watch.elapsed_ms(), 0.0);
+}
+
+TEST(PrefaultHeap, TouchesWholeBlocksUpToTheRequestAndNothingForZero) {
+  EXPECT_EQ(prefault_heap(0), 0u);
+  EXPECT_EQ(prefault_heap(1, 1 << 20), std::size_t{1} << 20);
+  EXPECT_EQ(prefault_heap((5u << 20) + 1, 1 << 20), std::size_t{6} << 20);
+  EXPECT_EQ(prefault_heap(10000, 100), 12288u);  // blocks of at least a page
 }
 
 }  // namespace

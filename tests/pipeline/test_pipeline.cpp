@@ -283,5 +283,23 @@ TEST(Pipeline, SummaryCountsAndPercentiles) {
   EXPECT_EQ(j["frames"], 36);
 }
 
+// The heap a run holds: the history of the longest gap plus the frames in flight; Stereo-Flow
+// keeps flow and edges too; unknown sizes prefault nothing.
+TEST(HeapEstimate, GrowsWithHistoryTokensAndMode) {
+  RunOptions o;
+  o.params.mode = core::Mode::kStereoFlow;
+  o.params.scene_flow.gaps = {1, 4, 10, 20};
+  const std::size_t px = 640 * 480;
+  EXPECT_EQ(heap_estimate(o, 640, 480), px * (13 * 20 + 48 * 3));
+  EXPECT_EQ(heap_estimate(o, 0, 480), 0u);
+  RunOptions stereo = o;
+  stereo.params.mode = core::Mode::kStereo;
+  stereo.params.stereo.gaps = {1, 5, 15};
+  EXPECT_EQ(heap_estimate(stereo, 640, 480), px * (4 * 15 + 48 * 3));
+  RunOptions wide = o;
+  wide.workers = 3;
+  EXPECT_GT(heap_estimate(wide, 640, 480), heap_estimate(o, 640, 480));
+}
+
 }  // namespace
 }  // namespace sg::pipeline

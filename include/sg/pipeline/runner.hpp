@@ -4,6 +4,7 @@
 /// a relay (in order: the detector's history), the labelling as farm tasks in row bands, the
 /// collector (restore order, obstacles, signals), and its metrics. This layer wires the vision
 /// kernels onto the par skeletons; it is the only place where both meet.
+#include <cstddef>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -34,7 +35,18 @@ struct RunOptions {
   /// Hand each detection its disparity and flow maps (core::Detection::disparity, flow), e.g. to
   /// dump them. Off by default: they would keep two full-size maps alive per stored detection.
   bool keep_maps = false;
+  /// Before the first frame, touch as much heap as the run will hold once its history of past
+  /// maps is full (par::prefault_heap, sized from the camera's width and height, the longest gap
+  /// and the tokens), so that the first frames do not fault their pages in. Worth it only where
+  /// freed memory stays on the heap; `stereoguard run` and `eval` set it (with glibc tuned in
+  /// main). Off by default.
+  bool prefault_heap = false;
 };
+
+/// The heap a run of `options` holds at most for a camera of `width` x `height` px, roughly:
+/// the history (disparity, and flow and depth edges in Stereo-Flow mode, for the longest gap)
+/// and every frame in flight with its maps and labelling outputs. Bytes.
+std::size_t heap_estimate(const RunOptions& options, int width, int height);
 
 /// Every violation as text; empty when valid (includes core::validate of the detector params).
 std::vector<std::string> validate(const RunOptions& options, const core::Camera& camera);

@@ -103,7 +103,10 @@ void allocate_stereo_flow_outputs(cv::Size size, cv::Mat& danger, cv::Mat& ttc, 
 /// times. Gaps whose steps exceed flows.size() or whose span is not positive are skipped; of
 /// gaps with equal steps the first given is used. edges_cur = mark_depth_edges of disp_cur.
 /// Outputs must be allocated (allocate_stereo_flow_outputs); only rows `rows` are written, so
-/// tiles stitched give the same maps as one call over all rows.
+/// tiles stitched give the same maps as one call over all rows. With p.pool_surface_motion and
+/// p.chain_stride > 1, candidates nearer than p.chain_stride_z_m are followed only on every
+/// chain_stride-th row and column (by absolute position); the others stay unlabelled, with an
+/// unknown velocity, for pool_surface_motion to fill in.
 void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
                             const std::vector<const cv::Mat*>& flows,
                             const std::vector<GapSource>& gaps, const core::Camera& cam,
