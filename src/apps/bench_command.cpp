@@ -21,7 +21,7 @@ struct BenchArgs {
   std::vector<double> pace = {0.8, 1.5};
   int frames = 300;
   int num_disparities = 64;
-  std::string matcher = "bm", cost = "sad";
+  std::string matcher = "fast", cost = "sad";  // run's defaults
   int threads = 0;
   std::string scenario = "head-on";
   std::string csv = "stereoguard-bench.csv";
@@ -101,7 +101,8 @@ void bench_main(const BenchArgs& a) {
   const std::string what = config.open_input ? "input " + a.input.spec.name() + " (read once)"
                                              : "scenario " + a.scenario + " (rendered once)";
   std::cout << "stereoguard bench: " << what << ", " << a.frames
-            << " frames per configuration held in memory\n"
+            << " frames per configuration held in memory; pipeline rows: matcher " << a.matcher
+            << " (baselines: bm)\n"
             << "kind     mode          resolution  W   T tok  pace/s     fps  vs-mt   vs-1t"
                "     p50     p99   drop  same\n"
             << "(vs-mt: speedup against the plain loop with OpenCV's threads, the default a user "

@@ -17,6 +17,17 @@ namespace sg::io {
 namespace fs = std::filesystem;
 namespace {
 
+/// An image size read as two numbers: whole numbers of pixels in 1..100000, checked before the
+/// cast (a double beyond int's range is undefined behaviour as an int; found by fuzz_euroc_calib
+/// and fuzz_kitti_calib).
+cv::Size image_size(const std::vector<double>& wh, const std::string& field, const fs::path& path) {
+  for (const double v : wh)
+    if (!(v >= 1.0 && v <= 100000.0 && v == std::floor(v)))
+      throw core::InputError(path.string() + ": " + field +
+                             " must be two whole numbers of pixels in 1..100000");
+  return {static_cast<int>(wh[0]), static_cast<int>(wh[1])};
+}
+
 bool all_finite(const cv::Mat& m) { return cv::checkRange(m, true, nullptr, -1e300, 1e300); }
 
 void check_matrix(std::vector<std::string>& out, const char* name, const cv::Mat& m, int rows,
@@ -182,15 +193,7 @@ EurocCamera read_euroc_camera(const fs::path& path) {
   cam.K = (cv::Mat_<double>(3, 3) << in[0], 0, in[2], 0, in[1], in[3], 0, 0, 1);
   const auto d = yaml_numbers(root, "distortion_coefficients", path, 0);
   cam.D = cv::Mat(d, true).reshape(1, 1);
-  const auto res = yaml_numbers(root, "resolution", path, 2);
-  for (const double v : res) {
-    // Checked before the cast: a double beyond int's range is undefined behaviour as an int.
-    if (!(v >= 1.0 && v <= 100000.0 && v == std::floor(v))) {
-      throw core::InputError(path.string() +
-                             ": resolution must be two whole numbers of pixels in 1..100000");
-    }
-  }
-  cam.size = cv::Size(static_cast<int>(res[0]), static_cast<int>(res[1]));
+  cam.size = image_size(yaml_numbers(root, "resolution", path, 2), "resolution", path);
   if (!root["T_BS"] || !root["T_BS"].IsMap()) {
     throw core::InputError(path.string() + ": missing field 'T_BS' (a 4x4 matrix with data:)");
   }
@@ -354,8 +357,9 @@ core::Camera read_kitti_calibration(const fs::path& path, int left_cam, int righ
   const auto& pr = kitti_key(lines, kitti_name("P_rect_", right_cam), 12, path);
   const auto& size = kitti_key(lines, kitti_name("S_rect_", left_cam), 2, path);
   core::Camera cam;
-  cam.width = static_cast<int>(size[0]);
-  cam.height = static_cast<int>(size[1]);
+  const cv::Size wh = image_size(size, kitti_name("S_rect_", left_cam), path);
+  cam.width = wh.width;
+  cam.height = wh.height;
   cam.focal_px = pl[0];
   cam.cx = pl[2];
   cam.cy = pl[6];

@@ -297,6 +297,8 @@ TEST_F(Cli, BenchWritesOneCsvRowPerConfigurationBesideItsBaselines) {
   }
   EXPECT_EQ(rows[7].rfind("paced,stereo,161,121,", 0), 0u) << rows[7];
   EXPECT_GT(fs::file_size(dir_ / "b.png"), 1000u);
+  // The pipeline rows use run's default matcher (it once said fast and ran bm).
+  EXPECT_NE(r.out.find("pipeline rows: matcher fast (baselines: bm)"), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, BenchRejectsBadSettings) {

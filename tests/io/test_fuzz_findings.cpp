@@ -192,6 +192,30 @@ TEST(FuzzFindings, EurocResolutionBeyondIntIsAnInputError) {
                        "resolution must be two whole numbers"));
 }
 
+// fuzz_kitti_calib: `S_rect_00: 1.242e+43 3.750000e+02` was cast to int (UBSan
+// float-cast-overflow), as the EuRoC resolution was.
+TEST(FuzzFindings, KittiRectifiedSizeBeyondIntIsAnInputError) {
+  ScratchDir dir;
+  const auto write = [&](const std::string& size) {
+    std::ofstream(dir.path() / "calib_cam_to_cam.txt")
+        << "S_rect_00: " << size << "\n"
+        << "P_rect_00: 7.2e+02 0 6.0e+02 0 0 7.2e+02 1.7e+02 0 0 0 1 0\n"
+        << "S_rect_01: 1.242e+03 3.75e+02\n"
+        << "P_rect_01: 7.2e+02 0 6.0e+02 -3.9e+02 0 7.2e+02 1.7e+02 0 0 0 1 0\n";
+  };
+  for (const std::string& bad : {"1.242e+43 3.75e+02", "1242.5 375", "0 375", "-1 375"}) {
+    write(bad);
+    EXPECT_TRUE(contains(
+        input_error_of([&] { read_kitti_calibration(dir.path() / "calib_cam_to_cam.txt", 0, 1); }),
+        "S_rect_00 must be two whole numbers"))
+        << bad;
+  }
+  write("1.242e+03 3.75e+02");
+  const core::Camera cam = read_kitti_calibration(dir.path() / "calib_cam_to_cam.txt", 0, 1);
+  EXPECT_EQ(cam.width, 1242);
+  EXPECT_EQ(cam.height, 375);
+}
+
 // fuzz_stereo_gt: a file that starts like a PGM ("P2") but holds DICOM's "DICM" mark at byte
 // 128 went to OpenCV's GDCM decoder, which aborted the process. PGMs are parsed by us now.
 TEST(FuzzFindings, PgmWithADicomMarkIsAnInputErrorNotADecoderAbort) {
