@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -107,10 +109,29 @@ cv::Mat fs_matrix(const cv::FileStorage& file, const char* name, const fs::path&
   return d;
 }
 
+/// YAML without OpenCV's "%YAML:1.0" directive, which yaml-cpp rejects; InputError when invalid.
+YAML::Node load_yaml(const fs::path& path);
+
 cv::FileStorage open_storage(const fs::path& path) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) {
     throw core::InputError("calibration file not found: " + path.string());
+  }
+  // OpenCV 4.6's YAML reader loops for hours on some malformed text (found by fuzz_calibration:
+  // 40 bytes, "  xx:3\n : [-0, 0 [-0, 0]"); yaml-cpp refuses such text at once, so a YAML file
+  // must pass it first.
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::string head(5, '\0');
+  std::ifstream(path, std::ios::binary).read(head.data(), 5);
+  if (ext == ".yml" || ext == ".yaml" || head == "%YAML") {
+    try {
+      (void)load_yaml(path);
+    } catch (const core::InputError& e) {
+      throw core::InputError("cannot parse calibration file " + path.string() +
+                             " (not valid YAML: " + e.what() + ")");
+    }
   }
   cv::FileStorage file;
   try {

@@ -216,6 +216,16 @@ TEST(FuzzFindings, KittiRectifiedSizeBeyondIntIsAnInputError) {
   EXPECT_EQ(cam.height, 375);
 }
 
+// fuzz_calibration: 40 bytes of malformed YAML kept OpenCV 4.6's YAML reader looping for over
+// ten minutes. A YAML calibration must now parse with yaml-cpp first, which refuses it at once.
+TEST(FuzzFindings, MalformedYamlThatHangsOpenCvIsRefusedFirst) {
+  ScratchDir dir;
+  std::ofstream(dir.path() / "c.yml", std::ios::binary) << "%YAML:1. 3\n  dt:\xfe\xff\xff\xff"
+                                                           "3\n : [-0, 0 [-0, 0]\n";
+  EXPECT_TRUE(contains(input_error_of([&] { read_calibration(dir.path() / "c.yml", false); }),
+                       "cannot parse"));
+}
+
 // fuzz_stereo_gt: a file that starts like a PGM ("P2") but holds DICOM's "DICM" mark at byte
 // 128 went to OpenCV's GDCM decoder, which aborted the process. PGMs are parsed by us now.
 TEST(FuzzFindings, PgmWithADicomMarkIsAnInputErrorNotADecoderAbort) {
