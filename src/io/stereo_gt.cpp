@@ -9,6 +9,7 @@
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
+#include <utility>
 
 #include "sg/core/error.hpp"
 #include "sg/io/gt_formats.hpp"
@@ -258,15 +259,23 @@ void write_pfm(const fs::path& path, const cv::Mat& disparity) {
               static_cast<std::streamsize>(disparity.cols * sizeof(float)));
 }
 
-cv::Mat read_middlebury_png(const fs::path& path, double scale) {
-  if (!(scale > 0)) throw core::InputError("gt_scale=" + std::to_string(scale) + ": must be > 0");
-  cv::Mat raw = read_gt_image(path);
+namespace {
+
+/// A decoded 8-bit Middlebury GT image (read_gt_image of `path`) divided by its scale (> 0).
+cv::Mat middlebury_disparity(cv::Mat raw, double scale, const fs::path& path) {
   if (raw.depth() != CV_8U)
     throw core::InputError(path.string() + ": Middlebury GT must be an 8-bit PNG");
   if (raw.channels() != 1) cv::extractChannel(raw, raw, 0);
   cv::Mat out;
   raw.convertTo(out, CV_32F, 1.0 / scale);
   return out;
+}
+
+}  // namespace
+
+cv::Mat read_middlebury_png(const fs::path& path, double scale) {
+  if (!(scale > 0)) throw core::InputError("gt_scale=" + std::to_string(scale) + ": must be > 0");
+  return middlebury_disparity(read_gt_image(path), scale, path);
 }
 
 cv::Mat read_stereo_gt(const fs::path& path, double scale) {
@@ -278,7 +287,7 @@ cv::Mat read_stereo_gt(const fs::path& path, double scale) {
                            ": 8-bit GT needs its scale (disparity = value / scale): give "
                            "--gt-scale or a datasets.xml");
   }
-  return read_middlebury_png(path, scale);
+  return middlebury_disparity(std::move(raw), scale, path);  // decoded once
 }
 
 std::vector<StereoGtPair> find_stereo_gt_pairs(const fs::path& dir, double scale) {
