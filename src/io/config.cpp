@@ -185,6 +185,7 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("grow_into_edges", p.scene_flow.grow_into_edges)
         .field("compensate_rotation", p.scene_flow.compensate_rotation)
         .field("longest_gap_decides", p.scene_flow.longest_gap_decides)
+        .field("fit_velocity", p.scene_flow.fit_velocity)
         .field("use_envelope_band", p.scene_flow.use_envelope_band)
         .field("exclude_ground", p.scene_flow.exclude_ground)
         .section("ground")

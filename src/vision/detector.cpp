@@ -81,7 +81,7 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
     const int reach = std::min(static_cast<int>(job.flows_.size()), static_cast<int>(past_.size()));
     const bool derotate = params_.scene_flow.compensate_rotation && !maps.flow.empty();
     if (derotate) flow_derotation = derotation(estimate_ego_motion(maps.flow, disp, camera_));
-    for (int k : params_.scene_flow.gaps) {
+    for (int k : sampled_gaps(params_.scene_flow)) {
       // Usable once the chain reaches k camera frames back; then the oldest frame at most k
       // frames back (at least the previous one): without drops exactly frame i - k.
       if (reach == 0 || frame.index - past_[static_cast<size_t>(reach - 1)].index < k) continue;

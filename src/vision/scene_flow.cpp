@@ -1,9 +1,10 @@
 #include "sg/vision/scene_flow.hpp"
 
 #include <algorithm>
-#include <opencv2/imgproc.hpp>
 #include <cmath>
 #include <limits>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
 
@@ -53,6 +54,27 @@ class PixelTest {
         env_(env),
         p_(p) {}
 
+  /// The 3D point seen at (x, y) with disparity d > 0, m.
+  cv::Vec3d point(float x, float y, float d) const {
+    const double z = fb_ / d;
+    return {(x - cx_) * z * inv_f_, (y - cy_) * z * inv_f_, z};
+  }
+
+  /// The verdict for the point P_i = point(x, y, d_cur) moving at V (m/s), measured over span_s
+  /// seconds: the noise gate (the disparity P_i had span_s seconds earlier at that velocity is at
+  /// least min_delta_d_px below d_cur), the speed gate, then heads_into_envelope.
+  GapResult verdict(const cv::Vec3d& P, float d_cur, const cv::Vec3d& V, double span_s) const {
+    GapResult r;
+    r.velocity = V;
+    r.velocity_known = true;
+    const double z_before = P[2] - V[2] * span_s;
+    if (!(z_before > 0.0) || static_cast<double>(d_cur) - fb_ / z_before < p_.min_delta_d_px ||
+        V.dot(V) > max_speed2_)
+      return r;
+    r.dangerous = heads_into_envelope(cv::Point3d(P), V, env_, p_.v_min_mps, r.ttc);
+    return r;
+  }
+
   /// derotate (may be null): turns P_{i-k} into frame i's orientation.
   GapResult operator()(float x, float y, float d_cur, cv::Point2f q, float d_prev, double span_s,
                        const cv::Matx33d* derotate = nullptr) const {
@@ -75,6 +97,37 @@ class PixelTest {
   double fb_, inv_f_, cx_, cy_, max_speed2_;
   const core::Envelope& env_;
   const SceneFlowParams& p_;
+};
+
+/// Weighted least-squares line through a point's 3D positions over time: t = 0 now, t < 0 in
+/// the past frames of its chain; the slope is its velocity.
+struct VelocityFit {
+  double sw = 0.0, st = 0.0, stt = 0.0;
+  cv::Vec3d sp, stp;
+  double span_s = 0.0;  ///< the oldest sample's distance in time, s
+  int n = 0;
+
+  void reset(const cv::Vec3d& now) {
+    *this = VelocityFit{};
+    add(0.0, now, 1.0);
+  }
+  void add(double t, const cv::Vec3d& P, double w) {
+    sw += w;
+    st += w * t;
+    stt += w * t * t;
+    sp += w * P;
+    stp += (w * t) * P;
+    span_s = std::max(span_s, -t);
+    ++n;
+  }
+  /// False with fewer than two samples at distinct times.
+  bool slope(cv::Vec3d& v) const {
+    if (n < 2) return false;
+    const double tb = st / sw, spread = stt - st * tb;  // sum w (t - tb)^2
+    if (!(spread > 0.0)) return false;
+    v = (stp - tb * sp) * (1.0 / spread);
+    return true;
+  }
 };
 
 /// mark_depth_edges at one pixel: the valid disparities of the window around (x, y) span more
@@ -186,6 +239,14 @@ bool heads_into_envelope(const cv::Point3d& P, const cv::Vec3d& V, const core::E
   return true;
 }
 
+std::vector<int> sampled_gaps(const SceneFlowParams& p) {
+  if (!p.fit_velocity || p.gaps.empty()) return p.gaps;
+  std::vector<int> all(
+      static_cast<size_t>(std::max(1, *std::max_element(p.gaps.begin(), p.gaps.end()))));
+  std::iota(all.begin(), all.end(), 1);
+  return all;
+}
+
 void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const cv::Mat& flow,
                        const core::Camera& cam, const core::Envelope& env,
                        const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
@@ -206,7 +267,7 @@ void label_stereo_flow_window(const cv::Mat& disp_cur,
   if (disp_cur.type() != CV_32FC1) throw core::InputError("scene flow: disparity must be CV_32F");
   const int history = static_cast<int>(std::min(past_disps.size(), past_flows.size()));
   std::vector<GapSource> gaps;
-  for (int k : p.gaps) {
+  for (int k : sampled_gaps(p)) {
     if (k < 1 || k > history) continue;
     const cv::Mat* edges = nullptr;
     if (edges_past) {
@@ -287,8 +348,10 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
   // next step, so the independent chains overlap instead of waiting on one another. Only
   // candidates are followed (the chains are the cost of the labelling), kept in a compact list.
   std::vector<cv::Point2f> q(disp_cur.cols);
-  std::vector<int> live;
+  std::vector<int> live, candidates;
   live.reserve(disp_cur.cols);
+  candidates.reserve(disp_cur.cols);
+  std::vector<VelocityFit> fits(p.fit_velocity ? disp_cur.cols : 0);
   for (int y = r.start; y < r.end; ++y) {
     const float* d_row = disp_cur.ptr<float>(y);
     const uint8_t* edge_row = edges_cur.ptr<uint8_t>(y);
@@ -297,6 +360,7 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
     cv::Vec3f* vel_row = velocity.ptr<cv::Vec3f>(y);
     live.clear();
     const bool stride_row = y % stride == 0;
+    const auto fy = static_cast<float>(y);
     for (int x = 0; x < disp_cur.cols; ++x) {
       danger_row[x] = 0;
       ttc_row[x] = kNaN;
@@ -306,8 +370,10 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
           (!p.use_envelope_band || in_band(y, d_row[x]))) {
         q[x] = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
         live.push_back(x);
+        if (p.fit_velocity) fits[x].reset(test.point(static_cast<float>(x), fy, d_row[x]));
       }
     }
+    candidates = live;
     int step = 0;
     for (const GapSource& g : gaps) {
       for (; step < g.steps && !live.empty(); ++step) {
@@ -324,6 +390,20 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
       }
       if (live.empty()) break;
       const cv::Mat& past = *g.disparity;
+      if (p.fit_velocity) {
+        for (const int x : live) {
+          float d_prev;
+          if (!sample_disparity_bilinear(past, q[x].x, q[x].y, d_prev, max_step) ||
+              !(d_prev > 0.0f) || past_edge(g, q[x]))
+            continue;
+          cv::Vec3d P = test.point(q[x].x, q[x].y, d_prev);
+          if (g.derotate) P = *g.derotate * P;
+          // Weight 1 / var(Z) relative to now's: Z's error grows as Z^2 = (f B / d)^2.
+          const double rel = static_cast<double>(d_prev) / d_row[x];
+          fits[x].add(-g.span_s, P, rel * rel * rel * rel);
+        }
+        continue;
+      }
       for (const int x : live) {
         float d_prev;
         if (!sample_disparity_bilinear(past, q[x].x, q[x].y, d_prev, max_step)) continue;
@@ -350,6 +430,16 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
           vel_row[x] = v;  // larger gaps come later: least noisy wins
         }
       }
+    }
+    if (!p.fit_velocity) continue;
+    for (const int x : candidates) {
+      cv::Vec3d V;
+      if (!fits[x].slope(V)) continue;
+      const cv::Vec3d P = test.point(static_cast<float>(x), fy, d_row[x]);
+      const GapResult res = test.verdict(P, d_row[x], V, fits[x].span_s);
+      danger_row[x] = res.dangerous ? 255 : 0;
+      ttc_row[x] = res.dangerous ? static_cast<float>(res.ttc) : kNaN;
+      vel_row[x] = cv::Vec3f(res.velocity);
     }
   }
 }

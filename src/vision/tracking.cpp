@@ -93,6 +93,7 @@ void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacl
       track.id = next_id_++;
       track.first_s = time_s;
     }
+    const cv::Rect last_bbox = track.bbox;
     track.bbox = o.bbox;
     o.track_id = track.id;
     // A blob measured nearer than the margin has a disparity at the top of the search range,
@@ -101,7 +102,11 @@ void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacl
                                o.distance_m < kNearRangeMargin * z_near_limit_m_;
     if (out_of_reach(track, time_s) ||
         (measured_near && track.fitted && track.fit_rate < -kMinClosingMps)) {
-      // Its disparity is beyond the matcher's range: the measurement is not the obstacle's.
+      // Its disparity is beyond the matcher's range: the measurement is not the obstacle's, and
+      // the blob is at most a fragment of it (an approaching object does not shrink), so it keeps
+      // the box it was last seen with too.
+      track.bbox = last_bbox | o.bbox;
+      o.bbox = track.bbox;
       double z_now = 0;
       track.predict(time_s, z_now);
       set_from_fit(z_now, track.fit_rate, o);

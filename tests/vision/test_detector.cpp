@@ -175,9 +175,10 @@ TEST(DetectorStereoFlow, HeadOnPatchFiresWithItsVelocity) {
   }
   EXPECT_FALSE(out[0].signal);
   EXPECT_EQ(cv::countNonZero(out[0].danger), 0);  // no history yet
-  // Gap 1 sees 0.36 px a frame, below min_delta_d_px; gap 4 (from frame 4) sees 1.7 px. With
-  // on_k = 2 the signal is on from frame 5 to the end.
-  for (int i = 0; i < 16; ++i) EXPECT_EQ(out[i].signal, i >= 5) << "frame " << i;
+  // The disparity grows by 0.36 px a frame, below min_delta_d_px; the velocity fit over frames
+  // 0..2 (from frame 2) sees 0.7 px over its span. With on_k = 2 the signal is on from frame 3 to
+  // the end. (Without the fit, the gaps 1, 4, ...: gap 4 from frame 4, the signal from frame 5.)
+  for (int i = 0; i < 16; ++i) EXPECT_EQ(out[i].signal, i >= 3) << "frame " << i;
   const core::Detection& last = out[15];
   ASSERT_TRUE(last.signal);
   EXPECT_TRUE(last.regions[1].fired);
@@ -226,6 +227,7 @@ TEST(DetectorStereoFlow, CrossingPatchNeverFiresWhereStereoModeDoes) {
 TEST(DetectorStereoFlow, GapsNeedAnUnbrokenChainOfFlows) {
   core::DetectorParams params = flow_params();
   params.scene_flow.gaps = {2};
+  params.scene_flow.fit_velocity = false;  // one gap's own semantics
   params.signal.on_k = 1;
   params.signal.on_n = 1;
   Detector det(params, camera());
@@ -250,27 +252,33 @@ TEST(DetectorStereoFlow, GapsNeedAnUnbrokenChainOfFlows) {
 // A dropped frame (index 3 never arrives) shortens the chain instead of restarting it: frame 4's
 // flow leads to frame 2, so gap 2 compares with frame 2 over one flow and 0.2 s, and the patch
 // stays dangerous; a chain restart would have left frames 4 and 5 without gap 2.
+// With the velocity fit (default), the samples carry their real times too.
 TEST(DetectorStereoFlow, DroppedFrameShortensTheChain) {
-  core::DetectorParams params = flow_params();
-  params.scene_flow.gaps = {2};
-  params.signal.on_k = 1;
-  params.signal.on_n = 1;
-  Detector det(params, camera());
-  cv::RNG rng(14);
-  std::vector<bool> dangerous;
-  std::vector<double> ttc;
-  for (int i : {0, 1, 2, 4, 5, 6}) {
-    const double z = 5.0 - 0.3 * i;  // 3 m/s at 10 fps
-    const core::Detection d =
-        det.process(frame(i), {scene(z, rng, 0.05), i == 0 ? cv::Mat() : patch_flow(kPatch, 0)});
-    dangerous.push_back(cv::countNonZero(d.danger) > 0);
-    ttc.push_back(d.obstacles.empty() || !d.obstacles[0].ttc_s ? -1.0 : *d.obstacles[0].ttc_s);
+  for (bool fit : {false, true}) {
+    core::DetectorParams params = flow_params();
+    params.scene_flow.gaps = {2};
+    params.scene_flow.fit_velocity = fit;
+    params.signal.on_k = 1;
+    params.signal.on_n = 1;
+    Detector det(params, camera());
+    cv::RNG rng(14);
+    std::vector<bool> dangerous;
+    std::vector<double> ttc;
+    for (int i : {0, 1, 2, 4, 5, 6}) {
+      const double z = 5.0 - 0.3 * i;  // 3 m/s at 10 fps
+      const core::Detection d =
+          det.process(frame(i), {scene(z, rng, 0.05), i == 0 ? cv::Mat() : patch_flow(kPatch, 0)});
+      dangerous.push_back(cv::countNonZero(d.danger) > 0);
+      ttc.push_back(d.obstacles.empty() || !d.obstacles[0].ttc_s ? -1.0 : *d.obstacles[0].ttc_s);
+    }
+    EXPECT_FALSE(dangerous[0]) << "fit " << fit;
+    // Gap 2 alone needs two frames; the fit samples every frame up to it.
+    EXPECT_EQ(dangerous[1], fit);
+    for (size_t j = 2; j < dangerous.size(); ++j)
+      EXPECT_TRUE(dangerous[j]) << "arrival " << j << " fit " << fit;
+    // The time span is the real one: frame 4 (z = 3.8 m) against frame 2 (4.4 m) over 0.2 s.
+    EXPECT_NEAR(ttc[3], (3.8 - params.envelope.z_contact_m) / 3.0, 0.25) << "fit " << fit;
   }
-  EXPECT_FALSE(dangerous[0]);
-  EXPECT_FALSE(dangerous[1]);
-  for (size_t j = 2; j < dangerous.size(); ++j) EXPECT_TRUE(dangerous[j]) << "arrival " << j;
-  // The time span is the real one: frame 4 (z = 3.8 m) against frame 2 (4.4 m) over 0.2 s.
-  EXPECT_NEAR(ttc[3], (3.8 - params.envelope.z_contact_m) / 3.0, 0.25);
 }
 
 TEST(DetectorStereoFlow, BadFlowIsAnInputError) {

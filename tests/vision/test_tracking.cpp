@@ -177,6 +177,36 @@ TEST(ObstacleTracker, TrackNearerThanTheMatcherSeesCoastsUntilContact) {
   }
 }
 
+// Beyond the matcher's reach only fragments of the object are left (aliased disparities): the
+// coasting track keeps the box it was last seen with instead of shrinking to a fragment's, so the
+// next frame's fragments still match it and the painted danger still covers the object.
+TEST(ObstacleTracker, CoastingTrackKeepsItsBoxOverAFragment) {
+  core::SignalParams p;
+  const double z_contact = 0.4, near_limit = 0.95, speed = 1.4;
+  ObstacleTracker tracker(p, z_contact, near_limit);
+  const cv::Rect whole(100, 50, 300, 300), fragment(320, 260, 20, 10);
+  double z = 3.0;
+  int id = -1;
+  // Whole down to 1.15 m, nearer than 1.25 x the near limit: then out of reach.
+  for (int i = 0; z > 1.15; ++i, z = 3.0 - speed * i / 30.0) {
+    std::vector<core::Obstacle> obs{box_at(whole, z, 9.0)};
+    tracker.update(i / 30.0, obs);
+    id = obs[0].track_id;
+  }
+  int predicted = 0;
+  for (int i = 0; z > 0.6; ++i) {
+    z = 1.15 - speed * (i + 1) / 30.0;
+    std::vector<core::Obstacle> obs{box_at(fragment, 1.5, 9.0)};  // an aliased distance
+    tracker.update((1.85 / speed) + (i + 1) / 30.0, obs);
+    ASSERT_EQ(obs.size(), 1u) << i;
+    if (!obs[0].predicted) continue;
+    ++predicted;
+    EXPECT_EQ(obs[0].track_id, id) << i;
+    EXPECT_EQ(obs[0].bbox, whole | fragment) << i;
+  }
+  EXPECT_GT(predicted, 10);  // 1.15 m to 0.6 m at 1.4 m/s: 12 frames
+}
+
 TEST(SeverityHold, RisesAtOnceFallsAfterItsFrames) {
   core::SignalParams p;
   p.severity_off_frames = 3;

@@ -217,6 +217,14 @@ struct SceneFlowParams {
   /// of the longer ones is lost (the point left the image, or an invalid disparity) or the history
   /// is short. false: a pixel is dangerous when any gap flags it (TTC: the smallest).
   bool longest_gap_decides = true;
+  /// The velocity of a pixel is the weighted least-squares slope of its 3D position over every
+  /// frame of its chain up to the longest gap (positions weighted by 1 / var(Z), i.e. by d^4),
+  /// instead of the difference between now and the longest gap's frame alone
+  /// (longest_gap_decides and the gaps below the longest are then not used). The error of a far
+  /// surface's disparity is largely common to all its pixels and changes from frame to frame
+  /// (simulated head-on-fast, a box 20 m away: -0.22 to +0.07 px against a growth of 0.6 px over
+  /// 20 frames), so pooling over pixels cannot remove it, while averaging over frames does.
+  bool fit_velocity = true;
   /// The point must lie in the envelope's vertical band now too (y_top <= Y_i <= y_bottom), as in
   /// Stereo mode: ground and overhead points then cannot enter the envelope through noise in V_y.
   bool use_envelope_band = true;

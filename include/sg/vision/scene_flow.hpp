@@ -59,7 +59,7 @@ void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const 
                        const core::Camera& cam, const core::Envelope& env, const SceneFlowParams& p,
                        double dt, cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity);
 
-/// Stereo-Flow labelling over several frame gaps (p.gaps). past_disps[j] = D_{i-1-j} and
+/// Stereo-Flow labelling over several frame gaps (sampled_gaps(p)). past_disps[j] = D_{i-1-j} and
 /// past_flows[j] = B_{i-j} (newest first: past_flows[0] is the current frame's flow). For gap k
 /// the point is followed back along the chained flow q_0 = p, q_{m+1} = q_m + B_{i-m}(q_m)
 /// (bilinear) to q_k, and V = (P_i(p) - P_{i-k}(q_k, D_{i-k}(q_k))) / (k dt); the test is that of
@@ -77,6 +77,10 @@ void label_stereo_flow_window(const cv::Mat& disp_cur,
                               const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
                               cv::Mat& velocity, const cv::Mat* edges_cur = nullptr,
                               const std::vector<const cv::Mat*>* edges_past = nullptr);
+
+/// The frame gaps the labelling samples: p.gaps, or with p.fit_velocity every gap from 1 to the
+/// longest of p.gaps (the fit uses each frame of the chain).
+std::vector<int> sampled_gaps(const SceneFlowParams& p);
 
 /// One gap of the Stereo-Flow labelling: the past frame whose disparity the chained flow reaches
 /// after `steps` flows, and the time between it and the current frame.
