@@ -213,7 +213,8 @@ EurocCamera read_euroc_camera(const fs::path& path) {
   const auto in = yaml_numbers(root, "intrinsics", path, 4);
   cam.K = (cv::Mat_<double>(3, 3) << in[0], 0, in[2], 0, in[1], in[3], 0, 0, 1);
   const auto d = yaml_numbers(root, "distortion_coefficients", path, 0);
-  cam.D = cv::Mat(d, true).reshape(1, 1);
+  // An empty list stays an empty matrix (validate() names it); reshape would throw on it.
+  if (!d.empty()) cam.D = cv::Mat(d, true).reshape(1, 1);
   cam.size = image_size(yaml_numbers(root, "resolution", path, 2), "resolution", path);
   if (!root["T_BS"] || !root["T_BS"].IsMap()) {
     throw core::InputError(path.string() + ": missing field 'T_BS' (a 4x4 matrix with data:)");

@@ -192,6 +192,22 @@ TEST(FuzzFindings, EurocResolutionBeyondIntIsAnInputError) {
                        "resolution must be two whole numbers"));
 }
 
+// fuzz_euroc_calib: `distortion_coefficients: []` made cv::Mat::reshape throw a cv::Exception,
+// which nothing caught (terminate).
+TEST(FuzzFindings, EurocEmptyDistortionIsAnInputError) {
+  ScratchDir dir;
+  const std::string rest =
+      "T_BS:\n  cols: 4\n  rows: 4\n  data: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"
+      "rate_hz: 20\nintrinsics: [50, 50, 32, 24]\nresolution: [64, 48]\n";
+  std::ofstream(dir.path() / "left.yaml") << rest << "distortion_coefficients: []\n";
+  std::ofstream(dir.path() / "right.yaml") << rest << "distortion_coefficients: [0, 0, 0, 0]\n";
+  EXPECT_TRUE(contains(input_error_of([&] {
+                         read_euroc_calibration(dir.path() / "left.yaml",
+                                                dir.path() / "right.yaml");
+                       }),
+                       "calib.D1: must hold 4, 5, 8, 12 or 14 coefficients, has 0"));
+}
+
 // fuzz_kitti_calib: `S_rect_00: 1.242e+43 3.750000e+02` was cast to int (UBSan
 // float-cast-overflow), as the EuRoC resolution was.
 TEST(FuzzFindings, KittiRectifiedSizeBeyondIntIsAnInputError) {
