@@ -177,34 +177,32 @@ TEST(FuzzFindings, GtImageThatIsNotPngOrPgmIsRefusedBeforeDecoding) {
                        "GT disparity is not a PNG or PGM image"));
 }
 
+/// The input error of reading an EuRoC pair whose left sensor.yaml has these resolution and
+/// distortion lists (the right one is sound).
+std::string euroc_error(const std::string& resolution, const std::string& distortion) {
+  ScratchDir dir;
+  const auto write = [&dir](const char* name, const std::string& res, const std::string& dist) {
+    std::ofstream(dir.path() / name)
+        << "T_BS:\n  cols: 4\n  rows: 4\n  data: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"
+        << "rate_hz: 20\nintrinsics: [50, 50, 32, 24]\nresolution: " << res
+        << "\ndistortion_coefficients: " << dist << "\n";
+  };
+  write("left.yaml", resolution, distortion);
+  write("right.yaml", "[64, 48]", "[0, 0, 0, 0]");
+  return input_error_of(
+      [&] { read_euroc_calibration(dir.path() / "left.yaml", dir.path() / "right.yaml"); });
+}
+
 // fuzz_euroc_calib: `resolution: [5.6e34, 48]` was cast to int (UBSan float-cast-overflow).
 TEST(FuzzFindings, EurocResolutionBeyondIntIsAnInputError) {
-  ScratchDir dir;
-  const std::string rest =
-      "T_BS:\n  cols: 4\n  rows: 4\n  data: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"
-      "rate_hz: 20\nintrinsics: [50, 50, 32, 24]\ndistortion_coefficients: [0, 0, 0, 0]\n";
-  std::ofstream(dir.path() / "left.yaml") << rest << "resolution: [5.6e34, 48]\n";
-  std::ofstream(dir.path() / "right.yaml") << rest << "resolution: [64, 48]\n";
-  EXPECT_TRUE(contains(input_error_of([&] {
-                         read_euroc_calibration(dir.path() / "left.yaml",
-                                                dir.path() / "right.yaml");
-                       }),
+  EXPECT_TRUE(contains(euroc_error("[5.6e34, 48]", "[0, 0, 0, 0]"),
                        "resolution must be two whole numbers"));
 }
 
 // fuzz_euroc_calib: `distortion_coefficients: []` made cv::Mat::reshape throw a cv::Exception,
 // which nothing caught (terminate).
 TEST(FuzzFindings, EurocEmptyDistortionIsAnInputError) {
-  ScratchDir dir;
-  const std::string rest =
-      "T_BS:\n  cols: 4\n  rows: 4\n  data: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"
-      "rate_hz: 20\nintrinsics: [50, 50, 32, 24]\nresolution: [64, 48]\n";
-  std::ofstream(dir.path() / "left.yaml") << rest << "distortion_coefficients: []\n";
-  std::ofstream(dir.path() / "right.yaml") << rest << "distortion_coefficients: [0, 0, 0, 0]\n";
-  EXPECT_TRUE(contains(input_error_of([&] {
-                         read_euroc_calibration(dir.path() / "left.yaml",
-                                                dir.path() / "right.yaml");
-                       }),
+  EXPECT_TRUE(contains(euroc_error("[64, 48]", "[]"),
                        "calib.D1: must hold 4, 5, 8, 12 or 14 coefficients, has 0"));
 }
 
