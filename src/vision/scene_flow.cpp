@@ -80,16 +80,15 @@ class PixelTest {
                        const cv::Matx33d* derotate = nullptr) const {
     GapResult r;
     if (!(d_prev > 0.0f)) return r;  // d_cur > 0 was checked by the caller
-    const double z = fb_ / d_cur, zp = fb_ / d_prev;
-    const cv::Vec3d P((x - cx_) * z * inv_f_, (y - cy_) * z * inv_f_, z);
-    cv::Vec3d Pp((q.x - cx_) * zp * inv_f_, (q.y - cy_) * zp * inv_f_, zp);
+    const cv::Vec3d P = point(x, y, d_cur);
+    cv::Vec3d Pp = point(q.x, q.y, d_prev);
     if (derotate) Pp = *derotate * Pp;
     r.velocity = (P - Pp) * (1.0 / span_s);
     r.velocity_known = true;
     if (static_cast<double>(d_cur) - d_prev < p_.min_delta_d_px ||
         r.velocity.dot(r.velocity) > max_speed2_)
       return r;
-    r.dangerous = heads_into_envelope(P, r.velocity, env_, p_.v_min_mps, r.ttc);
+    r.dangerous = heads_into_envelope(cv::Point3d(P), r.velocity, env_, p_.v_min_mps, r.ttc);
     return r;
   }
 
