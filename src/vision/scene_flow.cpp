@@ -105,10 +105,12 @@ struct VelocityFit {
   cv::Vec3d sp, stp;
   double span_s = 0.0;  ///< the oldest sample's distance in time, s
   int n = 0;
+  cv::Vec3d now;  ///< the position at t = 0
 
-  void reset(const cv::Vec3d& now) {
+  void reset(const cv::Vec3d& position) {
     *this = VelocityFit{};
-    add(0.0, now, 1.0);
+    now = position;
+    add(0.0, position, 1.0);
   }
   void add(double t, const cv::Vec3d& P, double w) {
     sw += w;
@@ -372,7 +374,7 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
         if (p.fit_velocity) fits[x].reset(test.point(static_cast<float>(x), fy, d_row[x]));
       }
     }
-    candidates = live;
+    if (p.fit_velocity) candidates = live;
     int step = 0;
     for (const GapSource& g : gaps) {
       for (; step < g.steps && !live.empty(); ++step) {
@@ -434,8 +436,7 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
     for (const int x : candidates) {
       cv::Vec3d V;
       if (!fits[x].slope(V)) continue;
-      const cv::Vec3d P = test.point(static_cast<float>(x), fy, d_row[x]);
-      const GapResult res = test.verdict(P, d_row[x], V, fits[x].span_s);
+      const GapResult res = test.verdict(fits[x].now, d_row[x], V, fits[x].span_s);
       danger_row[x] = res.dangerous ? 255 : 0;
       ttc_row[x] = res.dangerous ? static_cast<float>(res.ttc) : kNaN;
       vel_row[x] = cv::Vec3f(res.velocity);
