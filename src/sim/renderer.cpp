@@ -183,24 +183,36 @@ double shade(const Scene& sc, const Hit& hit, const cv::Vec3d& o, const cv::Vec3
          kContrast * texture_value(local[u], local[v], hash_combine(b.seed, face), fp);
 }
 
+/// Identity of the surface a ray hit (sky, ground, wall, or one face of one box): where it
+/// differs between neighbouring pixels, a silhouette or a fold runs between them.
+std::int32_t surface_code(const Hit& hit) {
+  if (hit.surface != Surface::kBox) return static_cast<std::int32_t>(hit.surface);
+  return 4 + (hit.box * 3 + hit.axis) * 2 + hit.side;
+}
+
 /// Outputs of render_rows; null members are not produced.
 struct RowTargets {
   cv::Mat* gray = nullptr;         // CV_8UC1
   const cv::Mat* noise = nullptr;  // CV_32F, may be null
   double gain = 1.0;
+  int edge_samples = 1;          // Scenario::edge_samples
   cv::Mat* disparity = nullptr;  // CV_32F
   cv::Mat* flow = nullptr;       // CV_32FC2
   cv::Mat* ids = nullptr;        // CV_16U
+  // Scratch of the gray image between the two passes: the centre ray's shade and surface.
+  cv::Mat* shade = nullptr;  // CV_32F
+  cv::Mat* code = nullptr;   // CV_32S
 };
 
-/// Renders rows [rows.start, rows.end) of the camera at `eye`. Each pixel depends only on its own
-/// ray, so any split into row ranges gives the same images.
+/// Renders rows [rows.start, rows.end) of the camera at `eye` with one ray through each pixel's
+/// centre; for the gray image only its shade and surface (integrate_rows finishes it). Each pixel
+/// depends only on its own ray, so any split into row ranges gives the same images.
 void render_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, cv::Range rows,
                  int width) {
   for (int y = rows.start; y < rows.end; ++y) {
     const double dy = (y - sc.cy) / sc.f;
-    auto* gray = out.gray ? out.gray->ptr<std::uint8_t>(y) : nullptr;
-    const auto* noise = out.noise ? out.noise->ptr<float>(y) : nullptr;
+    auto* shade_row = out.shade ? out.shade->ptr<float>(y) : nullptr;
+    auto* code_row = out.code ? out.code->ptr<std::int32_t>(y) : nullptr;
     auto* disp = out.disparity ? out.disparity->ptr<float>(y) : nullptr;
     auto* flow = out.flow ? out.flow->ptr<cv::Vec2f>(y) : nullptr;
     auto* ids = out.ids ? out.ids->ptr<std::uint16_t>(y) : nullptr;
@@ -208,10 +220,9 @@ void render_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, c
       const double dx = (x - sc.cx) / sc.f;
       const cv::Vec3d dir = sc.rot * cv::Vec3d(dx, dy, 1.0);
       const Hit hit = cast(sc, eye, dir);
-      if (gray) {
-        double value = shade(sc, hit, eye, dir) * out.gain;
-        if (noise) value += noise[x];
-        gray[x] = cv::saturate_cast<std::uint8_t>(value);
+      if (shade_row) {
+        shade_row[x] = static_cast<float>(shade(sc, hit, eye, dir));
+        code_row[x] = surface_code(hit);
       }
       const bool is_box = hit.surface == Surface::kBox;
       if (ids) ids[x] = is_box ? static_cast<std::uint16_t>(sc.boxes[hit.box].id) : 0;
@@ -245,10 +256,58 @@ void render_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, c
   }
 }
 
-void render_parallel(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, int width,
+/// The gray rows [rows.start, rows.end) from render_rows' shades, as a pixel integrates light:
+/// where the centre ray's surface differs from a 4-neighbour's, the pixel's shade is the mean of
+/// edge_samples^2 rays on a regular grid over its area; elsewhere the centre ray's. Then gain and
+/// noise.
+void integrate_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out,
+                    cv::Range rows) {
+  const cv::Mat& code = *out.code;
+  const int n = out.edge_samples, w = code.cols, h = code.rows;
+  for (int y = rows.start; y < rows.end; ++y) {
+    const auto* c = code.ptr<std::int32_t>(y);
+    const auto* above = y > 0 ? code.ptr<std::int32_t>(y - 1) : c;
+    const auto* below = y + 1 < h ? code.ptr<std::int32_t>(y + 1) : c;
+    const auto* shade_row = out.shade->ptr<float>(y);
+    const auto* noise = out.noise ? out.noise->ptr<float>(y) : nullptr;
+    auto* gray = out.gray->ptr<std::uint8_t>(y);
+    for (int x = 0; x < w; ++x) {
+      double value = shade_row[x];
+      const bool edge = (x > 0 && c[x - 1] != c[x]) || (x + 1 < w && c[x + 1] != c[x]) ||
+                        above[x] != c[x] || below[x] != c[x];
+      if (n > 1 && edge) {
+        double sum = 0.0;
+        for (int j = 0; j < n; ++j) {
+          const double dy = (y - 0.5 + (j + 0.5) / n - sc.cy) / sc.f;
+          for (int i = 0; i < n; ++i) {
+            const double dx = (x - 0.5 + (i + 0.5) / n - sc.cx) / sc.f;
+            const cv::Vec3d dir = sc.rot * cv::Vec3d(dx, dy, 1.0);
+            sum += shade(sc, cast(sc, eye, dir), eye, dir);
+          }
+        }
+        value = sum / (n * n);
+      }
+      value *= out.gain;
+      if (noise) value += noise[x];
+      gray[x] = cv::saturate_cast<std::uint8_t>(value);
+    }
+  }
+}
+
+void render_parallel(const Scene& sc, const cv::Vec3d& eye, RowTargets out, int width,
                      int height) {
+  cv::Mat shade, code;
+  if (out.gray) {
+    shade.create(height, width, CV_32FC1);
+    code.create(height, width, CV_32SC1);
+    out.shade = &shade;
+    out.code = &code;
+  }
   cv::parallel_for_(cv::Range(0, height),
                     [&](const cv::Range& r) { render_rows(sc, eye, out, r, width); });
+  if (out.gray)
+    cv::parallel_for_(cv::Range(0, height),
+                      [&](const cv::Range& r) { integrate_rows(sc, eye, out, r); });
 }
 
 /// Per-obstacle truth from the ids map; fills danger when given.
@@ -399,6 +458,7 @@ RenderedFrame Renderer::render(int index) const {
   RowTargets left;
   left.gray = &r.frame.left;
   left.noise = noise[0].empty() ? nullptr : &noise[0];
+  left.edge_samples = s.edge_samples;
   left.disparity = &r.maps.disparity;
   left.flow = index > 0 ? &r.maps.flow : nullptr;
   left.ids = &r.maps.ids;
@@ -408,6 +468,7 @@ RenderedFrame Renderer::render(int index) const {
   right.gray = &r.frame.right;
   right.noise = noise[1].empty() ? nullptr : &noise[1];
   right.gain = s.right_gain;
+  right.edge_samples = s.edge_samples;
   render_parallel(sc, sc.eye + sc.rot * cv::Vec3d(s.camera.baseline_m, 0, 0), right, w, h);
 
   r.truth = frame_truth(s, index, r.maps.ids, &r.maps.danger);

@@ -199,8 +199,8 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
                {"name", "description", "frames", "camera", "height_m", "ego_velocity_mps",
                 "camera_motion", "platform",
                 "background_z_m", "background_height_m", "ground_seed", "background_seed",
-                "noise_sigma", "right_gain", "noise_seed", "envelope", "min_area_px",
-                "obstacles"});
+                "noise_sigma", "right_gain", "noise_seed", "edge_samples", "envelope",
+                "min_area_px", "obstacles"});
   Scenario s;
   s.name = std::filesystem::path(path).stem().string();
   if (root["name"]) s.name = r.text(root["name"], "name");
@@ -221,6 +221,7 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
   if (root["noise_sigma"]) s.noise_sigma = r.number(root["noise_sigma"], "noise_sigma");
   if (root["right_gain"]) s.right_gain = r.number(root["right_gain"], "right_gain");
   if (root["noise_seed"]) s.noise_seed = r.seed(root["noise_seed"], "noise_seed");
+  if (root["edge_samples"]) s.edge_samples = r.integer(root["edge_samples"], "edge_samples");
   if (root["envelope"]) read_envelope(r, root["envelope"], s.envelope);
   if (root["min_area_px"]) s.min_area_px = r.integer(root["min_area_px"], "min_area_px");
   if (const YAML::Node obstacles = root["obstacles"]) {
@@ -302,6 +303,8 @@ std::vector<std::string> validate(const Scenario& s) {
             "must be >= 0");
   c.require(std::isfinite(s.right_gain) && s.right_gain > 0, "right_gain", s.right_gain,
             "must be > 0");
+  c.require(s.edge_samples >= 1 && s.edge_samples <= 8, "edge_samples", s.edge_samples,
+            "must be in 1..8");
   c.require(s.min_area_px >= 0, "min_area_px", s.min_area_px, "must be >= 0");
   const CameraMotion& m = s.camera_motion;
   c.require(std::isfinite(m.yaw_rate_dps), "camera_motion.yaw_rate_dps", m.yaw_rate_dps,
@@ -415,6 +418,7 @@ std::string to_yaml(const Scenario& s) {
   e << YAML::Key << "noise_sigma" << YAML::Value << to_text(s.noise_sigma);
   e << YAML::Key << "right_gain" << YAML::Value << to_text(s.right_gain);
   e << YAML::Key << "noise_seed" << YAML::Value << s.noise_seed;
+  e << YAML::Key << "edge_samples" << YAML::Value << s.edge_samples;
   e << YAML::Key << "envelope" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "half_width_m" << YAML::Value << to_text(s.envelope.half_width_m);
   e << YAML::Key << "y_top_m" << YAML::Value << to_text(s.envelope.y_top_m);

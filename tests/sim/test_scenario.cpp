@@ -97,6 +97,7 @@ TEST(Scenario, ValidateNamesEachBadField) {
   s.background_z_m = 0;
   s.noise_sigma = -0.5;
   s.right_gain = 0;
+  s.edge_samples = 9;
   s.obstacles[1].id = s.obstacles[0].id;
   s.obstacles[2].id = 0;
   s.obstacles[3].size_m[2] = 0;
@@ -107,6 +108,7 @@ TEST(Scenario, ValidateNamesEachBadField) {
   EXPECT_TRUE(mentions(problems, "background_z_m=0"));
   EXPECT_TRUE(mentions(problems, "noise_sigma=-0.5"));
   EXPECT_TRUE(mentions(problems, "right_gain=0"));
+  EXPECT_TRUE(mentions(problems, "edge_samples=9: must be in 1..8"));
   EXPECT_TRUE(mentions(problems, "obstacles[1].id=1: must be unique"));
   EXPECT_TRUE(mentions(problems, "obstacles[2].id=0"));
   EXPECT_TRUE(mentions(problems, "obstacles[3].size_m"));
@@ -126,6 +128,7 @@ TEST(Scenario, YamlRoundTripKeepsEveryField) {
   s.noise_sigma = 0.7;
   s.right_gain = 0.9;
   s.noise_seed = 99;
+  s.edge_samples = 2;
   s.envelope = {0.6, -0.9, 0.8, 0.4, 2.5};
   s.min_area_px = 77;
   s.obstacles[1].texture_seed = 1234;
@@ -164,6 +167,7 @@ TEST(Scenario, YamlRoundTripKeepsEveryField) {
   EXPECT_EQ(r.noise_sigma, 0.7);
   EXPECT_EQ(r.right_gain, 0.9);
   EXPECT_EQ(r.noise_seed, 99U);
+  EXPECT_EQ(r.edge_samples, 2);
   EXPECT_EQ(r.envelope.half_width_m, 0.6);
   EXPECT_EQ(r.envelope.y_top_m, -0.9);
   EXPECT_EQ(r.envelope.y_bottom_m, 0.8);

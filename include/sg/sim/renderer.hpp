@@ -29,7 +29,10 @@ struct RenderedFrame {
 core::ObstacleTruth box_collision(const Scenario& s, const Box& box, double t_s);
 
 /// Pure function of (scenario, frame index): rendering frame i never depends on other frames.
-/// Pixel (x, y) looks along R(t) ((x - cx) / f, (y - cy) / f, 1) (R = camera_rotation); the left
+/// Pixel (x, y) looks along R(t) ((x - cx) / f, (y - cy) / f, 1) (R = camera_rotation); its gray
+/// level is that ray's shade, or, where the surface it hits differs from a 4-neighbour's, the mean
+/// of Scenario::edge_samples^2 rays over the pixel's area (the ground-truth maps stay those of
+/// the centre ray). The left
 /// camera sits at ego_velocity * t, the right one baseline_m further along the camera's X axis.
 /// GT disparity = f B / Z with Z the depth in the camera frame; GT backward flow = the pixel of the
 /// same surface point in the previous frame's camera (its pose and rotation then). Rows are rendered with
