@@ -23,6 +23,7 @@ struct BenchArgs {
   int num_disparities = 64;
   std::string matcher = "fast", cost = "sad";  // run's defaults
   int threads = 0;
+  int tokens = 0;
   std::string scenario = "head-on";
   std::string csv = "stereoguard-bench.csv";
   std::string plot;
@@ -88,6 +89,7 @@ void bench_main(const BenchArgs& a) {
   config.matcher = core::parse_matcher(a.matcher);
   config.cost = core::parse_match_cost(a.cost);
   config.threads = a.threads;
+  config.tokens = a.tokens;
   config.scenario = a.scenario;
   config.pace_fractions = a.pace;
   if (a.input.spec.any() || a.input.sbs) {
@@ -136,6 +138,7 @@ void add_bench_command(CLI::App& app) {
                   "stay StereoBM)");
   cmd->add_option("--cost", a->cost, "fast matcher cost: sad (default) or census");
   cmd->add_option("--threads", a->threads, "task-arena size (default 0 = all cores)");
+  cmd->add_option("--tokens", a->tokens, "frames in flight of the pipeline rows (default 0: W + 1, or W when paced)");
   cmd->add_option("--scenario", a->scenario, "scenario rendered for the frames (default head-on)");
   cmd->add_option("--pace", a->pace,
                   "also pace the best configuration at these fractions of its capacity "

@@ -198,6 +198,7 @@ std::vector<BenchRow> run_bench(const BenchConfig& config,
       options.params.bm.matcher = config.matcher;
       options.params.bm.cost = config.cost;
       options.threads = config.threads;
+      options.tokens = config.tokens;
       core::throw_if_invalid(validate(options, camera), "invalid bench settings");
 
       Measured baseline = run_baseline(frames, camera, options.params, 1);

@@ -227,7 +227,12 @@ std::string format_ms(double v) {
 
 }  // namespace
 
-int effective_tokens(const RunOptions& o) { return o.tokens > 0 ? o.tokens : o.workers + 1; }
+int effective_tokens(const RunOptions& o) {
+  if (o.tokens > 0) return o.tokens;
+  // A file read as fast as possible keeps one frame ready beyond the workers. A paced source
+  // does not: a frame waiting for a worker only ages while the camera captures a newer one.
+  return o.pace_fps > 0 ? o.workers : o.workers + 1;
+}
 
 std::size_t heap_estimate(const RunOptions& o, int width, int height) {
   if (width <= 0 || height <= 0) return 0;

@@ -267,6 +267,18 @@ TEST(Pipeline, InvalidOptionsAreNamed) {
   EXPECT_EQ(effective_tokens(RunOptions{}), 2);
 }
 
+TEST(Pipeline, AutomaticTokensKeepAFrameReadyForAFileButNoneWhenPaced) {
+  RunOptions o;
+  o.workers = 3;
+  EXPECT_EQ(effective_tokens(o), 4);
+  o.pace_fps = 30;
+  EXPECT_EQ(effective_tokens(o), 3);
+  o.tokens = 5;  // an explicit count stands either way
+  EXPECT_EQ(effective_tokens(o), 5);
+  o.pace_fps = 0;
+  EXPECT_EQ(effective_tokens(o), 5);
+}
+
 TEST(Pipeline, SummaryCountsAndPercentiles) {
   RunSummary s;
   RunOptions o = options_for(core::Mode::kStereo);

@@ -24,6 +24,7 @@ struct BenchConfig {
   core::Matcher matcher = core::Matcher::kFast;
   core::MatchCost cost = core::MatchCost::kSad;  ///< fast matcher's cost
   int threads = 0;           ///< task-arena size (0 = all cores)
+  int tokens = 0;            ///< frames in flight of the pipeline rows (0 = automatic: RunOptions)
   std::string scenario = "head-on";
   /// Also run the best configuration of each mode (first resolution) paced at these fractions of
   /// its measured capacity (empty = none).
