@@ -16,6 +16,62 @@ bool finite(const cv::Vec3f& v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
 }
 
+/// Union-find root with path halving.
+int find_root(std::vector<int>& parent, int i) {
+  while (parent[static_cast<size_t>(i)] != i) {
+    parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
+    i = parent[static_cast<size_t>(i)];
+  }
+  return i;
+}
+
+/// Labels (CV_32S, 0 = none, 1..count-1) the 8-connected components of the `member` pixels
+/// (CV_8U nonzero) whose neighbours' disparities differ by at most `step`; returns count.
+int label_continuous(const cv::Mat& disp, const cv::Mat& member, float step, cv::Mat& labels) {
+  const int w = disp.cols, h = disp.rows;
+  std::vector<int> parent(static_cast<size_t>(w) * static_cast<size_t>(h), -1);
+  auto unite = [&parent](int a, int b) {
+    a = find_root(parent, a);
+    b = find_root(parent, b);
+    if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+  };
+  for (int y = 0; y < h; ++y) {
+    const float* d = disp.ptr<float>(y);
+    const float* du = y > 0 ? disp.ptr<float>(y - 1) : nullptr;
+    const std::uint8_t* m = member.ptr<std::uint8_t>(y);
+    const std::uint8_t* mu = y > 0 ? member.ptr<std::uint8_t>(y - 1) : nullptr;
+    for (int x = 0; x < w; ++x) {
+      if (!m[x]) continue;
+      const int i = y * w + x;
+      parent[static_cast<size_t>(i)] = i;
+      if (x > 0 && m[x - 1] && std::abs(d[x - 1] - d[x]) <= step) unite(i, i - 1);
+      if (!mu) continue;
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int xx = x + dx;
+        if (xx < 0 || xx >= w || !mu[xx] || std::abs(du[xx] - d[x]) > step) continue;
+        unite(i, i - w + dx);
+      }
+    }
+  }
+  labels.create(disp.size(), CV_32SC1);
+  std::vector<int> id(parent.size(), 0);
+  int count = 1;
+  for (int y = 0; y < h; ++y) {
+    int* l = labels.ptr<int>(y);
+    for (int x = 0; x < w; ++x) {
+      const int i = y * w + x;
+      if (parent[static_cast<size_t>(i)] < 0) {
+        l[x] = 0;
+        continue;
+      }
+      const int r = find_root(parent, i);
+      if (id[static_cast<size_t>(r)] == 0) id[static_cast<size_t>(r)] = count++;
+      l[x] = id[static_cast<size_t>(r)];
+    }
+  }
+  return count;
+}
+
 }  // namespace
 
 float interquartile_mean(std::vector<float>& v) {
@@ -44,22 +100,26 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   // The labelling's candidates: valid, near enough, off the depth-edge margin, in the band.
   const float d_min = static_cast<float>(cam.focal_px * cam.baseline_m / p.z_max_m);
-  cv::Mat candidate(disp.size(), CV_8UC1);
+  // Surfaces: the same without the depth-edge test, joined where neighbours' disparities are
+  // continuous: the margin keeps a pixel out of the test, not out of its object.
+  cv::Mat candidate(disp.size(), CV_8UC1), member(disp.size(), CV_8UC1);
   for (int y = 0; y < disp.rows; ++y) {
     const float* d = disp.ptr<float>(y);
     const std::uint8_t* e = edges.ptr<std::uint8_t>(y);
     std::uint8_t* c = candidate.ptr<std::uint8_t>(y);
+    std::uint8_t* m = member.ptr<std::uint8_t>(y);
     for (int x = 0; x < disp.cols; ++x) {
-      bool ok = d[x] > 0.0f && d[x] >= d_min && e[x] == 0;
+      bool ok = d[x] > 0.0f && d[x] >= d_min;
       if (ok && p.use_envelope_band) {
         const double Y = (y - cam.cy) * cam.baseline_m / d[x];
         ok = Y >= env.y_top_m && Y <= env.y_bottom_m;
       }
-      c[x] = ok ? 255 : 0;
+      m[x] = ok ? 255 : 0;
+      c[x] = ok && e[x] == 0 ? 255 : 0;
     }
   }
   cv::Mat labels;
-  const int count = cv::connectedComponents(candidate, labels, 8, CV_32S);
+  const int count = label_continuous(disp, member, static_cast<float>(p.edge_step_px), labels);
   // Velocity components per surface, then their interquartile means.
   std::vector<std::vector<float>> vx(static_cast<size_t>(count)), vy(vx.size()), vz(vx.size());
   for (int y = 0; y < disp.rows; ++y) {
@@ -87,10 +147,11 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
     std::uint8_t* out = danger.ptr<std::uint8_t>(y);
     float* t = ttc.ptr<float>(y);
     cv::Vec3f* v = velocity.ptr<cv::Vec3f>(y);
+    const std::uint8_t* c = candidate.ptr<std::uint8_t>(y);
     for (int x = 0; x < disp.cols; ++x) {
       out[x] = 0;
       t[x] = kNaN;
-      if (l[x] == 0 || !finite(pooled[static_cast<size_t>(l[x])])) {
+      if (l[x] == 0 || c[x] == 0 || !finite(pooled[static_cast<size_t>(l[x])])) {
         v[x] = cv::Vec3f(kNaN, kNaN, kNaN);
         continue;
       }

@@ -140,6 +140,31 @@ TEST(PoolSurfaceMotion, PooledVelocityIsNotStuckToTheQuantizationGrid) {
   EXPECT_NEAR(m.velocity.at<cv::Vec3f>(60, 50)[2], -2.04, 0.015);
 }
 
+// A surface is one object where its disparity is continuous, even across pixels that the
+// depth-edge margin keeps out of the test: on overhang (area-integrated edges) such a margin cut a
+// 17 x 13 px piece off a bar 4.8 m away, and that piece alone pooled -1.51 m/s for a true -1.40:
+// an early alarm. The piece pools with the rest of the bar; a patch at another depth stays apart.
+TEST(PoolSurfaceMotion, MarginPixelsJoinTheirObjectButNotAnotherDepth) {
+  const core::SceneFlowParams p;
+  Maps m;
+  cv::RNG rng(17);
+  const cv::Rect piece(30, 40, 12, 12), rest(42, 40, 60, 12), band(42, 40, 4, 12);
+  m.patch(piece, 4.8, {0, 0, -1.7}, 0.0, rng);  // a few biased pixels of the object
+  m.patch(rest, 4.8, {0, 0, -1.4}, 0.0, rng);
+  m.edges(band).setTo(255);  // the margin cuts the piece off the rest
+  m.velocity(band).setTo(cv::Scalar(kNaN, kNaN, kNaN));
+  const cv::Rect other(30, 52, 72, 12);  // touches both, 2 m nearer: another object
+  m.patch(other, 2.8, {0, 0, 0}, 0.0, rng);
+  pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity);
+  // The piece takes the interquartile mean of the whole object (144 at -1.7, 672 at -1.4: -1.4).
+  EXPECT_NEAR(m.velocity.at<cv::Vec3f>(45, 35)[2], -1.4, 1e-5);
+  EXPECT_NEAR(m.velocity.at<cv::Vec3f>(45, 80)[2], -1.4, 1e-5);
+  EXPECT_NEAR(m.velocity.at<cv::Vec3f>(58, 35)[2], 0.0, 1e-5);
+  // Margin pixels join a surface but are never dangerous themselves.
+  EXPECT_EQ(cv::countNonZero(m.danger(band)), 0);
+  EXPECT_TRUE(std::isnan(m.velocity.at<cv::Vec3f>(45, 43)[2]));
+}
+
 TEST(PoolSurfaceMotion, MismatchedMapsAreAnInputError) {
   Maps m;
   cv::Mat small_ttc(10, 10, CV_32F);

@@ -184,9 +184,9 @@ struct SceneFlowParams {
   /// Pool the velocity over each surface before the envelope test (vision/segment_motion.hpp):
   /// the points of a rigid object share one velocity, and its per-pixel estimates scatter by
   /// about 10 % at 7 m, which tested pixel by pixel raises early alarms on large objects and
-  /// late ones on small far objects. Surfaces are the connected candidates of the labelling
-  /// (the depth-edge margin separates them); each takes the interquartile mean of the
-  /// velocities its pixels know.
+  /// late ones on small far objects. Surfaces are the connected pixels of continuous disparity
+  /// (steps of at most edge_step_px) in the band; each takes the interquartile mean of the
+  /// velocities its candidates know.
   bool pool_surface_motion = true;
   /// With pool_surface_motion, candidates nearer than chain_stride_z_m (> 0) are followed back
   /// along the flow chain only on every chain_stride-th row and column (1..8; 1 = all of them):
