@@ -13,6 +13,7 @@
 
 #include "gray.hpp"
 #include "sg/core/error.hpp"
+#include "sg/core/yaml_text.hpp"
 #include "sg/io/stereo_folder.hpp"
 
 namespace sg::io {
@@ -165,8 +166,10 @@ YAML::Node load_yaml(const fs::path& path) {
     if (line.rfind("%YAML", 0) == 0) continue;
     text << line << "\n";
   }
+  const std::string yaml = text.str();
+  core::check_flow_nesting(yaml, "cannot parse " + path.string());
   try {
-    return YAML::Load(text.str());
+    return YAML::Load(yaml);
   } catch (const YAML::Exception& e) {
     std::string what = e.what();
     std::replace(what.begin(), what.end(), '\n', ' ');
