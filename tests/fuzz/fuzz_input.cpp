@@ -10,13 +10,14 @@
 // malloc_context_size=2: ASan keeps the stack of every allocation and free, unwinding by frame
 // pointers, which yaml-cpp, OpenCV and libstdc++ (not built by us) do not keep. From the third
 // frame on it reads whatever those libraries left in the frame-pointer register, so the stacks
-// differ from one execution to the next and ASan's stack depot never stops growing: the same
-// camera.yaml run 500 and 2000 times left 13,889 and 33,388 stacks (malloc_context_size=3, same
-// with 30), fuzz_calibration grew by about 2 KB per execution (RSS 105 MB -> 1,030 MB in 316k
-// executions, so a 1M run ends at -rss_limit_mb=2048 as a false out-of-memory) and spent 11-23%
-// of its time in StackDepot::Put. Two frames (the allocator and its caller) are exact and take a
-// fixed set of stacks (714 for 100k runs of a calibration). The report of a bad access keeps its
-// full stack (ASan unwinds that one with the debug info).
+// differ from one execution to the next and ASan's stack depot never stops growing: one
+// calibration file run 1,000 and 4,000 times left 44,084 and 141,589 stacks (the default of 30
+// frames; 3 or 4 frames grow as fast). fuzz_calibration's RSS went from 565 MB after 16k
+// executions to 1,024 MB after 320k (1.5 KB per execution: about 2 GB, fuzz.sh's -rss_limit_mb,
+// by 1M executions, which would end the run as a false out-of-memory), and it spent 11-23% of
+// its time in StackDepot::Put. Two frames (the allocator and its caller) are exact and take a
+// fixed set of stacks (714 for 100k runs of a calibration). This limits only the allocated-by and
+// freed-by stacks of a report; the stack of the bad access itself is printed in full.
 extern "C" const char* __asan_default_options() { return "malloc_context_size=2"; }
 
 namespace sg::fuzz {
