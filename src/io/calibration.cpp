@@ -13,6 +13,7 @@
 
 #include "gray.hpp"
 #include "sg/core/error.hpp"
+#include "sg/core/yaml_text.hpp"
 #include "sg/io/stereo_folder.hpp"
 
 namespace sg::io {
@@ -112,7 +113,26 @@ cv::Mat fs_matrix(const cv::FileStorage& file, const char* name, const fs::path&
 /// YAML without OpenCV's "%YAML:1.0" directive, which yaml-cpp rejects; InputError when invalid.
 YAML::Node load_yaml(const fs::path& path);
 
-cv::FileStorage open_storage(const fs::path& path) {
+/// True for a file OpenCV reads as YAML: a .yml or .yaml name, or text starting with "%YAML".
+bool is_yaml_file(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".yml" || ext == ".yaml") return true;
+  std::string head(5, '\0');
+  std::ifstream(path, std::ios::binary).read(head.data(), 5);
+  return head == "%YAML";
+}
+
+/// The InputError for a YAML calibration file that yaml-cpp refuses (`why`: load_yaml's message).
+core::InputError invalid_yaml(const fs::path& path, const std::string& why) {
+  return core::InputError("cannot parse calibration file " + path.string() +
+                          " (not valid YAML: " + why + ")");
+}
+
+/// `yaml_checked`: the caller has already run load_yaml on the file and thrown invalid_yaml if it
+/// failed on a YAML file, so the file need not be parsed a second time here.
+cv::FileStorage open_storage(const fs::path& path, bool yaml_checked) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) {
     throw core::InputError("calibration file not found: " + path.string());
@@ -120,17 +140,11 @@ cv::FileStorage open_storage(const fs::path& path) {
   // OpenCV 4.6's YAML reader loops for hours on some malformed text (found by fuzz_calibration:
   // 40 bytes, "  xx:3\n : [-0, 0 [-0, 0]"); yaml-cpp refuses such text at once, so a YAML file
   // must pass it first.
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  std::string head(5, '\0');
-  std::ifstream(path, std::ios::binary).read(head.data(), 5);
-  if (ext == ".yml" || ext == ".yaml" || head == "%YAML") {
+  if (!yaml_checked && is_yaml_file(path)) {
     try {
       (void)load_yaml(path);
     } catch (const core::InputError& e) {
-      throw core::InputError("cannot parse calibration file " + path.string() +
-                             " (not valid YAML: " + e.what() + ")");
+      throw invalid_yaml(path, e.what());
     }
   }
   cv::FileStorage file;
@@ -165,8 +179,10 @@ YAML::Node load_yaml(const fs::path& path) {
     if (line.rfind("%YAML", 0) == 0) continue;
     text << line << "\n";
   }
+  const std::string yaml = text.str();
+  core::check_flow_nesting(yaml, "cannot parse " + path.string());
   try {
-    return YAML::Load(text.str());
+    return YAML::Load(yaml);
   } catch (const YAML::Exception& e) {
     std::string what = e.what();
     std::replace(what.begin(), what.end(), '\n', ' ');
@@ -322,8 +338,11 @@ std::vector<std::string> validate(const StereoCalibration& c) {
   return out;
 }
 
-StereoCalibration read_opencv_calibration(const fs::path& path) {
-  cv::FileStorage file = open_storage(path);
+namespace {
+
+/// read_opencv_calibration; `yaml_checked` as for open_storage.
+StereoCalibration read_opencv_file(const fs::path& path, bool yaml_checked) {
+  cv::FileStorage file = open_storage(path, yaml_checked);
   StereoCalibration c;
   c.M1 = fs_matrix(file, "M1", path, true);
   c.D1 = fs_matrix(file, "D1", path, true);
@@ -351,6 +370,12 @@ StereoCalibration read_opencv_calibration(const fs::path& path) {
   c.image_size = cv::Size(width, height);
   core::throw_if_invalid(validate(c), "invalid calibration " + path.string());
   return c;
+}
+
+}  // namespace
+
+StereoCalibration read_opencv_calibration(const fs::path& path) {
+  return read_opencv_file(path, false);
 }
 
 void write_opencv_calibration(const fs::path& path, const StereoCalibration& c) {
@@ -432,15 +457,20 @@ Calibration read_calibration(const fs::path& path, bool kitti_color) {
   if (ext != ".xml" && ext != ".gz") {
     // stereoguard's camera.yaml is plain YAML, which OpenCV's reader may refuse.
     YAML::Node root;
+    std::string yaml_error;
     try {
       root = load_yaml(path);
-    } catch (const core::InputError&) {
-      root = YAML::Node();
+    } catch (const core::InputError& e) {
+      yaml_error = e.what();
     }
     if (root.IsMap() && root["focal_px"]) {
       out.rectified = read_camera_yaml(path, cv::Size(1, 1));  // size comes from the images
       return out;
     }
+    // The file has been through yaml-cpp once; open_storage's check would parse it again.
+    if (!yaml_error.empty() && is_yaml_file(path)) throw invalid_yaml(path, yaml_error);
+    out.stereo = read_opencv_file(path, true);
+    return out;
   }
   out.stereo = read_opencv_calibration(path);
   return out;

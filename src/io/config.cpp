@@ -2,12 +2,15 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <string>
 
 #include "sg/core/error.hpp"
+#include "sg/core/yaml_text.hpp"
 
 namespace sg::io {
 namespace {
@@ -79,9 +82,13 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
   if (!std::filesystem::is_regular_file(path)) {
     throw core::InputError("config file " + file + " does not exist");
   }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError("config file " + file + ": cannot open the file");
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  core::check_flow_nesting(text, "config file " + file);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file);
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw core::InputError("config file " + file + ": " + e.what());
   }

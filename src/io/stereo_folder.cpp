@@ -6,12 +6,15 @@
 #include <cctype>
 #include <charconv>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <system_error>
 
 #include "sg/core/error.hpp"
+#include "sg/core/yaml_text.hpp"
 #include "gray.hpp"
 #include "sg/io/gt_formats.hpp"
 
@@ -124,9 +127,13 @@ core::Camera read_camera_yaml(const fs::path& path, cv::Size size) {
   if (!fs::is_regular_file(path, ec)) {
     throw core::InputError("missing camera file: " + path.string());
   }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError("cannot parse " + path.string() + ": cannot open the file");
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  core::check_flow_nesting(text, "cannot parse " + path.string());
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path.string());
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw core::InputError("cannot parse " + path.string() + ": " + one_line(e.what()));
   }

@@ -7,12 +7,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <set>
 #include <sstream>
 
 #include "sg/core/error.hpp"
 #include "sg/core/platform.hpp"
+#include "sg/core/yaml_text.hpp"
 
 namespace sg::sim {
 namespace {
@@ -354,9 +356,13 @@ Scenario load_scenario_file(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw core::InputError(path + ": scenario file not found");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError(path + ": cannot read scenario: cannot open the file");
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  core::check_flow_nesting(text, path);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     throw core::InputError(path + ":" + std::to_string(e.mark.line + 1) +
                            ": YAML syntax error: " + e.msg);

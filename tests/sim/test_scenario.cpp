@@ -240,6 +240,12 @@ TEST(Scenario, BadFilesNameTheFileAndField) {
     EXPECT_NE(what.find(path), std::string::npos) << c.file << ": " << what;
     EXPECT_NE(what.find(c.field), std::string::npos) << c.file << ": " << what;
   }
+  // Flow collections nested more than 32 levels are refused before yaml-cpp recurses into them.
+  const std::string deep =
+      write_file("deep.yaml", "obstacles: " + std::string(33, '[') + std::string(33, ']') + "\n");
+  EXPECT_NE(load_error(deep).find(deep + ": collections ([ ] or { }) nested more than 32"),
+            std::string::npos)
+      << load_error(deep);
   const std::string missing = (fs::path(::testing::TempDir()) / "missing_sg.yaml").string();
   const std::string what = load_error(missing);
   EXPECT_NE(what.find(missing), std::string::npos) << what;
