@@ -1,5 +1,8 @@
 #include "sg/core/yaml_text.hpp"
 
+#include <fstream>
+#include <iterator>
+
 #include "sg/core/error.hpp"
 
 namespace sg::core {
@@ -51,6 +54,14 @@ void check_flow_nesting(std::string_view text, const std::string& where) {
     throw InputError(where + ": collections ([ ] or { }) nested more than " +
                      std::to_string(kMaxFlowNesting) + " levels deep");
   }
+}
+
+std::string read_yaml_text(const std::filesystem::path& path, const std::string& where) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(where + ": cannot open the file");
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  check_flow_nesting(text, where);
+  return text;
 }
 
 }  // namespace sg::core

@@ -2,9 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <fstream>
 #include <functional>
-#include <iterator>
 #include <map>
 #include <optional>
 #include <string>
@@ -82,10 +80,7 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
   if (!std::filesystem::is_regular_file(path)) {
     throw core::InputError("config file " + file + " does not exist");
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw core::InputError("config file " + file + ": cannot open the file");
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  core::check_flow_nesting(text, "config file " + file);
+  const std::string text = core::read_yaml_text(path, "config file " + file);
   YAML::Node root;
   try {
     root = YAML::Load(text);

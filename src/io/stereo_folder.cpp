@@ -7,7 +7,6 @@
 #include <charconv>
 #include <cstdio>
 #include <fstream>
-#include <iterator>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -127,10 +126,7 @@ core::Camera read_camera_yaml(const fs::path& path, cv::Size size) {
   if (!fs::is_regular_file(path, ec)) {
     throw core::InputError("missing camera file: " + path.string());
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw core::InputError("cannot parse " + path.string() + ": cannot open the file");
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  core::check_flow_nesting(text, "cannot parse " + path.string());
+  const std::string text = core::read_yaml_text(path, "cannot parse " + path.string());
   YAML::Node root;
   try {
     root = YAML::Load(text);

@@ -273,9 +273,9 @@ void integrate_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out
     auto* gray = out.gray->ptr<std::uint8_t>(y);
     for (int x = 0; x < w; ++x) {
       double value = shade_row[x];
-      const bool edge = (x > 0 && c[x - 1] != c[x]) || (x + 1 < w && c[x + 1] != c[x]) ||
-                        above[x] != c[x] || below[x] != c[x];
-      if (n > 1 && edge) {
+      const bool edge = n > 1 && ((x > 0 && c[x - 1] != c[x]) || (x + 1 < w && c[x + 1] != c[x]) ||
+                                  above[x] != c[x] || below[x] != c[x]);
+      if (edge) {
         double sum = 0.0;
         for (int j = 0; j < n; ++j) {
           const double dy = (y - 0.5 + (j + 0.5) / n - sc.cy) / sc.f;

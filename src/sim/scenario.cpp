@@ -7,7 +7,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -356,10 +355,7 @@ Scenario load_scenario_file(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw core::InputError(path + ": scenario file not found");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw core::InputError(path + ": cannot read scenario: cannot open the file");
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  core::check_flow_nesting(text, path);
+  const std::string text = core::read_yaml_text(path, path);
   YAML::Node root;
   try {
     root = YAML::Load(text);

@@ -3,6 +3,7 @@
 /// parses nested collections by recursion, one level per `[` or `{`, and refuses only at a few
 /// hundred levels, deep in the stack; a file of stereoguard's (config, scenario, camera.yaml,
 /// calibration) nests at most 6 levels.
+#include <filesystem>
 #include <string>
 #include <string_view>
 
@@ -19,5 +20,9 @@ int flow_nesting_depth(std::string_view text);
 /// Throws InputError "<where>: collections ([ ] or { }) nested more than 32 levels deep" when
 /// flow_nesting_depth(text) > kMaxFlowNesting.
 void check_flow_nesting(std::string_view text, const std::string& where);
+
+/// The whole text of the YAML or JSON file `path`, passed through check_flow_nesting; throws
+/// InputError "<where>: cannot open the file" when it cannot be opened.
+std::string read_yaml_text(const std::filesystem::path& path, const std::string& where);
 
 }  // namespace sg::core
