@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <numeric>
 
 #include "sg/core/error.hpp"
 #include "sg/vision/edge_margin.hpp"
@@ -81,10 +82,12 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
     const int reach = std::min(static_cast<int>(job.flows_.size()), static_cast<int>(past_.size()));
     const bool derotate = params_.scene_flow.compensate_rotation && !maps.flow.empty();
     if (derotate) flow_derotation = derotation(estimate_ego_motion(maps.flow, disp, camera_));
+    int reached = 0;
     for (int k : sampled_gaps(params_.scene_flow)) {
       // Usable once the chain reaches k camera frames back; then the oldest frame at most k
       // frames back (at least the previous one): without drops exactly frame i - k.
       if (reach == 0 || frame.index - past_[static_cast<size_t>(reach - 1)].index < k) continue;
+      reached = k;
       int m = 0;
       for (int j = 1; j < reach; ++j)
         if (frame.index - past_[static_cast<size_t>(j)].index <= k) m = j;
@@ -100,6 +103,8 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
         job.derotations_.push_back(chain);
       }
     }
+    // Over the first frames of a chain the disparity error dominates the fit (startup_doubt_px).
+    job.short_chain_ = params_.scene_flow.fit_velocity && reached < max_gap_;
     allocate_stereo_flow_outputs(disp.size(), job.danger_, job.ttc_, job.velocity_);
   } else {
     for (int k : params_.stereo.gaps)
@@ -126,8 +131,19 @@ void LabelJob::conclude() {
     // The velocities come from the longest gap that knows them: the noise gate uses its span.
     const double span_s =
         spans_s_.empty() ? 0.0 : *std::max_element(spans_s_.begin(), spans_s_.end());
+    // A chain short of its window: the spread of the fit's sample times (now and each past frame
+    // of the chain once; after a dropped frame two gaps reach the same one).
+    double spread = 0.0;
+    if (short_chain_) {
+      std::vector<double> times{0.0};
+      for (size_t j = 0; j < spans_s_.size(); ++j)
+        if (j == 0 || steps_[j] != steps_[j - 1]) times.push_back(-spans_s_[j]);
+      const double mean =
+          std::accumulate(times.begin(), times.end(), 0.0) / static_cast<double>(times.size());
+      for (double t : times) spread += (t - mean) * (t - mean);
+    }
     pool_surface_motion(disparity_, *camera_, p.envelope, sf, span_s, edges_, danger_, ttc_,
-                        velocity_);
+                        velocity_, spread);
   }
   if (flow_mode_ && sf.grow_into_edges)
     grow_danger_into_edges(disparity_, edges_, sf.edge_margin_px, sf.edge_step_px,

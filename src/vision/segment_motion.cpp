@@ -26,8 +26,10 @@ int find_root(std::vector<int>& parent, int i) {
 }
 
 /// Labels (CV_32S, 0 = none, 1..count-1) the 8-connected components of the `member` pixels
-/// (CV_8U nonzero) whose neighbours' disparities differ by at most `step`; returns count.
-int label_continuous(const cv::Mat& disp, const cv::Mat& member, float step, cv::Mat& labels) {
+/// (CV_8U nonzero) whose neighbours' disparities differ by at most `step`, also joining pixels of
+/// one column that far apart (see below); returns count.
+int label_continuous(const cv::Mat& disp, const cv::Mat& member, float step, double bridge_rows_per_px,
+                     cv::Mat& labels) {
   const int w = disp.cols, h = disp.rows;
   std::vector<int> parent(static_cast<size_t>(w) * static_cast<size_t>(h), -1);
   auto unite = [&parent](int a, int b) {
@@ -35,6 +37,15 @@ int label_continuous(const cv::Mat& disp, const cv::Mat& member, float step, cv:
     b = find_root(parent, b);
     if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
   };
+  // Per column, the last pixels of the few most recent runs of distinct disparity (index, row,
+  // disparity): a run that resumes within bridge_rows_per_px * d rows at a similar disparity d is
+  // the same surface seen past a stretch the matcher got wrong or left out.
+  struct Run {
+    int index = -1, row = 0;
+    float d = 0.0f;
+  };
+  constexpr int kRuns = 3;
+  std::vector<Run> runs(bridge_rows_per_px > 0.0 ? static_cast<size_t>(w) * kRuns : 0);
   for (int y = 0; y < h; ++y) {
     const float* d = disp.ptr<float>(y);
     const float* du = y > 0 ? disp.ptr<float>(y - 1) : nullptr;
@@ -45,12 +56,30 @@ int label_continuous(const cv::Mat& disp, const cv::Mat& member, float step, cv:
       const int i = y * w + x;
       parent[static_cast<size_t>(i)] = i;
       if (x > 0 && m[x - 1] && std::abs(d[x - 1] - d[x]) <= step) unite(i, i - 1);
-      if (!mu) continue;
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int xx = x + dx;
-        if (xx < 0 || xx >= w || !mu[xx] || std::abs(du[xx] - d[x]) > step) continue;
-        unite(i, i - w + dx);
+      if (mu) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int xx = x + dx;
+          if (xx < 0 || xx >= w || !mu[xx] || std::abs(du[xx] - d[x]) > step) continue;
+          unite(i, i - w + dx);
+        }
       }
+      if (runs.empty()) continue;
+      Run* col = &runs[static_cast<size_t>(x) * kRuns];
+      Run* slot = nullptr;
+      const double reach = bridge_rows_per_px * d[x];
+      for (int k = 0; k < kRuns; ++k) {
+        Run& r = col[k];
+        if (r.index >= 0 && y - r.row <= reach && std::abs(r.d - d[x]) <= step) {
+          unite(i, r.index);
+          if (!slot) slot = &r;
+        }
+      }
+      if (!slot) {  // a new run: it replaces the one seen longest ago
+        slot = col;
+        for (int k = 1; k < kRuns; ++k)
+          if (col[k].index < 0 || col[k].row < slot->row) slot = &col[k];
+      }
+      *slot = Run{i, y, d[x]};
     }
   }
   labels.create(disp.size(), CV_32SC1);
@@ -90,7 +119,8 @@ float interquartile_mean(std::vector<float>& v) {
 
 void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const core::Envelope& env,
                          const core::SceneFlowParams& p, double span_s, const cv::Mat& edges,
-                         cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity) {
+                         cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity,
+                         double time_spread_s2) {
   if (disp.type() != CV_32FC1 || edges.type() != CV_8UC1 || danger.type() != CV_8UC1 ||
       ttc.type() != CV_32FC1 || velocity.type() != CV_32FC3 || edges.size() != disp.size() ||
       danger.size() != disp.size() || ttc.size() != disp.size() || velocity.size() != disp.size())
@@ -119,7 +149,9 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
     }
   }
   cv::Mat labels;
-  const int count = label_continuous(disp, member, static_cast<float>(p.edge_step_px), labels);
+  // A gap of bridge_m at depth Z = f B / d spans bridge_m f / Z = (bridge_m / B) d rows.
+  const int count = label_continuous(disp, member, static_cast<float>(p.edge_step_px),
+                                     p.surface_bridge_m / cam.baseline_m, labels);
   // Velocity components per surface, then their interquartile means.
   std::vector<std::vector<float>> vx(static_cast<size_t>(count)), vy(vx.size()), vz(vx.size());
   for (int y = 0; y < disp.rows; ++y) {
@@ -160,10 +192,17 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
       const cv::Point3d P = cam.point(x, y, d[x]);
       const double z_before = P.z - V[2] * span_s;
       const bool grew = z_before > 0.0 && d[x] - fb / z_before >= p.min_delta_d_px;
+      // A short chain: the slowest approach along the same path that its error allows decides.
+      double keep = 1.0;
+      if (time_spread_s2 > 0.0 && V[2] < 0.0) {
+        const double sigma_v = P.z * p.startup_doubt_px / d[x] / std::sqrt(time_spread_s2);
+        keep = 1.0 - sigma_v / -V[2];
+      }
       double t_c = 0.0;
-      if (grew && V.dot(V) <= max_speed2 && heads_into_envelope(P, V, env, p.v_min_mps, t_c)) {
+      if (grew && keep > 0.0 && V.dot(V) <= max_speed2 &&
+          heads_into_envelope(P, V * keep, env, p.v_min_mps, t_c)) {
         out[x] = 255;
-        t[x] = static_cast<float>(t_c);
+        t[x] = static_cast<float>(t_c * keep);  // the TTC of V itself
       }
     }
   }

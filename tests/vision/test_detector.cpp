@@ -163,7 +163,8 @@ cv::Mat patch_flow(cv::Rect patch, float shift_x) {
 }
 
 TEST(DetectorStereoFlow, HeadOnPatchFiresWithItsVelocity) {
-  const core::DetectorParams params = flow_params();
+  core::DetectorParams params = flow_params();
+  params.scene_flow.gaps = {1, 4};  // a fit window of 4 frames (0.4 s at 10 fps)
   Detector det(params, camera());
   cv::RNG rng(11);
   std::vector<core::Detection> out;
@@ -175,10 +176,11 @@ TEST(DetectorStereoFlow, HeadOnPatchFiresWithItsVelocity) {
   }
   EXPECT_FALSE(out[0].signal);
   EXPECT_EQ(cv::countNonZero(out[0].danger), 0);  // no history yet
-  // The disparity grows by 0.36 px a frame, below min_delta_d_px; the velocity fit over frames
-  // 0..2 (from frame 2) sees 0.7 px over its span. With on_k = 2 the signal is on from frame 3 to
-  // the end. (Without the fit, the gaps 1, 4, ...: gap 4 from frame 4, the signal from frame 5.)
-  for (int i = 0; i < 16; ++i) EXPECT_EQ(out[i].signal, i >= 3) << "frame " << i;
+  // The disparity grows by 0.36 px a frame, below min_delta_d_px. Frames 2 and 3 fit a chain short
+  // of the longest gap: doubted by startup_doubt_px, their slowest plausible approach (1 m/s at
+  // frame 3) is too slow; from frame 4 the window is full (1.4 px over its span). With on_k = 2
+  // the signal is on from frame 5 to the end.
+  for (int i = 0; i < 16; ++i) EXPECT_EQ(out[i].signal, i >= 5) << "frame " << i;
   const core::Detection& last = out[15];
   ASSERT_TRUE(last.signal);
   EXPECT_TRUE(last.regions[1].fired);
@@ -272,13 +274,52 @@ TEST(DetectorStereoFlow, DroppedFrameShortensTheChain) {
       ttc.push_back(d.obstacles.empty() || !d.obstacles[0].ttc_s ? -1.0 : *d.obstacles[0].ttc_s);
     }
     EXPECT_FALSE(dangerous[0]) << "fit " << fit;
-    // Gap 2 alone needs two frames; the fit samples every frame up to it.
-    EXPECT_EQ(dangerous[1], fit);
+    // Gap 2 alone needs two frames; the fit's first pair (frame 1, 0.1 s) is doubted by
+    // startup_doubt_px: 3 m/s over 0.1 s at 4.7 m is within its noise.
+    EXPECT_FALSE(dangerous[1]) << "fit " << fit;
     for (size_t j = 2; j < dangerous.size(); ++j)
       EXPECT_TRUE(dangerous[j]) << "arrival " << j << " fit " << fit;
     // The time span is the real one: frame 4 (z = 3.8 m) against frame 2 (4.4 m) over 0.2 s.
     EXPECT_NEAR(ttc[3], (3.8 - params.envelope.z_contact_m) / 3.0, 0.25) << "fit " << fit;
   }
+}
+
+// Over the first frames of a chain the velocity fit is dominated by the disparity error
+// (simulated thin-pole: a 0.6 px step of the matcher within 4 frames at 7.6 m read -5.8 m/s for
+// a true -1.4, an alarm 4 s early), so until the chain reaches the longest gap the envelope test
+// doubts it by startup_doubt_px. Here (f B = 50 px m, 10 fps, gaps 1 and 10): a static patch 8 m
+// away whose disparity steps up by 1 px at frame 2 fits -6 m/s over 0.2 s (TTC 1.1 s) and alarms
+// when the first frames are trusted, never when doubted; a patch 5 m away at 3 m/s stands clear
+// of the doubt by frame 3 (0.3 m a frame: its slowest plausible approach, 2.1 m/s, meets the
+// 3 s horizon).
+TEST(DetectorStereoFlow, TheFirstFramesOfAChainAlarmOnlyOnAnApproachClearOfTheirNoise) {
+  auto dangerous_frames = [](double doubt_px, auto depth) {
+    core::DetectorParams params = flow_params();
+    params.scene_flow.gaps = {1, 10};
+    params.scene_flow.startup_doubt_px = doubt_px;
+    params.signal.on_k = 1;
+    params.signal.on_n = 1;
+    Detector det(params, camera());
+    cv::RNG rng(15);
+    std::vector<int> frames;
+    for (int i = 0; i < 8; ++i) {
+      const core::Detection d = det.process(
+          frame(i), {scene(depth(i), rng, 0.05), i == 0 ? cv::Mat() : patch_flow(kPatch, 0)});
+      if (cv::countNonZero(d.danger) > 0) frames.push_back(i);
+    }
+    return frames;
+  };
+  const double fb = camera().focal_px * camera().baseline_m;
+  auto stepped = [fb](int i) { return i < 2 ? 8.0 : fb / (fb / 8.0 + 1.0); };
+  auto approaching = [](int i) { return 5.0 - 0.3 * i; };
+  const std::vector<int> trusted = dangerous_frames(0.0, stepped);
+  ASSERT_FALSE(trusted.empty());
+  EXPECT_EQ(trusted.front(), 2);
+  EXPECT_TRUE(dangerous_frames(0.6, stepped).empty());
+  const std::vector<int> caught = dangerous_frames(0.6, approaching);
+  ASSERT_FALSE(caught.empty());
+  EXPECT_LE(caught.front(), 3);
+  EXPECT_EQ(caught.back(), 7);
 }
 
 TEST(DetectorStereoFlow, BadFlowIsAnInputError) {

@@ -165,6 +165,34 @@ TEST(PoolSurfaceMotion, MarginPixelsJoinTheirObjectButNotAnotherDepth) {
   EXPECT_TRUE(std::isnan(m.velocity.at<cv::Vec3f>(45, 43)[2]));
 }
 
+// A thin pole that the matcher breaks into pieces (simulated thin-pole: a stretch 0.25 m long
+// matched to the wall behind cut the top 0.3 m off, and that piece alone pooled -1.60 m/s for a
+// true -1.40, an early alarm) is one surface again where the pieces resume at a similar
+// disparity within surface_bridge_m down the same columns. Here a 6 px post 5 m ahead (f 100 px:
+// 0.3 m spans 6 rows); the short top piece reads -1.7 m/s (TTC 2.6 s, under the 3 s horizon),
+// the long lower one the true -1.4 (3.2 s).
+TEST(PoolSurfaceMotion, PiecesOfAPoleCutByAMismatchedStretchPoolAsOneSurface) {
+  auto top_dangerous = [](int stretch_rows, double bridge_m) {
+    core::SceneFlowParams p;
+    p.surface_bridge_m = bridge_m;
+    Maps m;
+    cv::RNG rng(19);
+    const cv::Rect top(60, 20, 6, 15);
+    const cv::Rect mismatched(60, top.br().y, 6, stretch_rows);
+    const cv::Rect lower(60, mismatched.br().y, 6, 60);
+    m.patch(top, 5.0, {0, 0, -1.7}, 0.0, rng);
+    m.patch(mismatched, 7.0, {0, 0, 0}, 0.0, rng);  // the wall's disparity, another surface
+    m.velocity(mismatched).setTo(cv::Scalar(kNaN, kNaN, kNaN));
+    m.patch(lower, 5.0, {0, 0, -1.4}, 0.0, rng);
+    pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity);
+    EXPECT_EQ(cv::countNonZero(m.danger(lower)), 0);
+    return cv::countNonZero(m.danger(top));
+  };
+  EXPECT_EQ(top_dangerous(5, 0.3), 0);        // bridged: the top pools -1.4 with the rest
+  EXPECT_EQ(top_dangerous(8, 0.3), 6 * 15);   // 0.4 m apart: two objects
+  EXPECT_EQ(top_dangerous(5, 0.0), 6 * 15);   // no bridge: the biased piece alarms alone
+}
+
 TEST(PoolSurfaceMotion, MismatchedMapsAreAnInputError) {
   Maps m;
   cv::Mat small_ttc(10, 10, CV_32F);

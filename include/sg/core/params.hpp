@@ -159,6 +159,14 @@ struct SceneFlowParams {
   /// The disparity must have grown by this much over the gap, D_i(p) - D_{i-k}(q) >= this, px:
   /// a noise gate, as in Stereo mode; 0 disables it.
   double min_delta_d_px = 0.5;
+  /// Until the velocity fit's chain reaches the longest gap (the first frames of a stream), the
+  /// disparity error dominates the fit (simulated thin-pole, 4 frames at 7.6 m: -5.8 m/s for a
+  /// true -1.4): the envelope test then uses the slowest approach along the measured path that
+  /// an error of this much in every disparity could hide, V (1 - sigma_V / -V_z), with sigma_V
+  /// the fit's standard error for depths that err by Z startup_doubt_px / d (pool_surface_motion).
+  /// 0.6 px: two standard errors of a 0.3 px matching error (a 1 px quantization's). A near,
+  /// fast approach stands clear of it within a few frames; 0 trusts the first frames fully.
+  double startup_doubt_px = 0.6;
   /// Velocities faster than this are mismatches and are ignored, m/s.
   double max_speed_mps = 40.0;
   /// The past disparity D_{i-k}(q) is unknown when the neighbours its bilinear sample uses differ
@@ -188,6 +196,13 @@ struct SceneFlowParams {
   /// (steps of at most edge_step_px) in the band; each takes the interquartile mean of the
   /// velocities its candidates know.
   bool pool_surface_motion = true;
+  /// With pool_surface_motion, a surface also continues down a column past a stretch of at most
+  /// this many metres (at its depth) where the matcher read something else, and resumes at a
+  /// disparity within edge_step_px: the block window mixes a thin pole with the background
+  /// behind it, so the matcher breaks it into pieces, and a small piece alone pools a biased
+  /// velocity (simulated thin-pole: the top 0.3 m of the pole, cut off by 0.25 m matched to the
+  /// wall, pooled -1.60 m/s for a true -1.40: an early alarm). 0 joins only neighbours, m.
+  double surface_bridge_m = 0.3;
   /// With pool_surface_motion, candidates nearer than chain_stride_z_m (> 0) are followed back
   /// along the flow chain only on every chain_stride-th row and column (1..8; 1 = all of them):
   /// their surfaces' velocities are pooled and tested at every pixel anyway, and a near object

@@ -73,6 +73,9 @@ class LabelJob {
   /// the current orientation; empty = no compensation.
   std::vector<cv::Matx33d> derotations_;
   cv::Mat danger_, ttc_, velocity_;
+  /// Stereo-Flow with the velocity fit: the chain does not reach the longest gap yet (the start
+  /// of a stream), so pooling doubts the fit by scene_flow.startup_doubt_px.
+  bool short_chain_ = false;
   bool concluded_ = false;
   std::vector<core::Obstacle> obstacles_;  ///< conclude(): untracked obstacles
   std::vector<int> region_pixels_;         ///< conclude(): dangerous pixels per region

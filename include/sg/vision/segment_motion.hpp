@@ -44,9 +44,14 @@ float interquartile_mean(std::vector<float>& v);
 /// gap's time: a motion too small to show over the gaps measured is noise, as at the start of a
 /// stream with gap 1 only); then heads_into_envelope(P, V, env, p.v_min_mps). Outputs,
 /// overwritten at every pixel: danger CV_8U 0/255, ttc CV_32F (s, NaN where safe), velocity =
-/// the surface's velocity (NaN elsewhere). All maps the same size.
+/// the surface's velocity (NaN elsewhere). All maps the same size. time_spread_s2 > 0 (a fit
+/// over a chain shorter than its window: sum (t - mean t)^2 of its sample times, s^2): the
+/// envelope test uses V (1 - sigma_V / -V_z) instead of V (nothing when that is <= 0), with
+/// sigma_V = (Z p.startup_doubt_px / d) / sqrt(time_spread_s2) at the pixel's depth; the TTC
+/// reported is that of V itself.
 void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const core::Envelope& env,
                          const core::SceneFlowParams& p, double span_s, const cv::Mat& edges,
-                         cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity);
+                         cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity,
+                         double time_spread_s2 = 0.0);
 
 }  // namespace sg::vision
