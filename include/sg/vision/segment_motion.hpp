@@ -28,7 +28,10 @@ float interquartile_mean(std::vector<float>& v);
 /// Relabels a Stereo-Flow frame with pooled velocities. Surfaces are the 8-connected components
 /// of the pixels with a valid disparity (disp, CV_32F, invalid < 0), Z <= p.z_max_m and, with
 /// p.use_envelope_band, inside the envelope's vertical band now, where neighbours' disparities
-/// differ by at most p.edge_step_px: a step separates objects at different depths. The
+/// differ by at most p.edge_step_px: a step separates objects at different depths. A surface
+/// also continues down a column across at most p.surface_bridge_m (at its depth: that times
+/// d / B rows) of other pixels where a disparity within p.edge_step_px resumes: a thin pole that
+/// the matcher cut into pieces stays one surface. The
 /// labelling's candidates are those off the depth-edge margin (`edges`, CV_8U, 255 = near a depth
 /// edge: depth_edges()); margin pixels join their surface but give no velocity and are never
 /// dangerous, so that the margin does not cut a small piece off an object (on overhang, with
