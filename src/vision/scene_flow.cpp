@@ -14,6 +14,7 @@ namespace sg::vision {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr int kMaxChainStride = 16;  ///< the sparsest grid of followed pixels, however near
 
 // Splits a coordinate into integer cell and fraction; false outside [0, n-1] or not finite.
 inline bool split(float v, int n, int& i, float& f) {
@@ -335,11 +336,19 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
 
   const float d_min = static_cast<float>(cam.focal_px * cam.baseline_m / p.z_max_m);
   // Nearer than chain_stride_z_m only every stride-th row and column is followed (pooling gives
-  // the others their surface's velocity); by absolute row, so tiles follow the same pixels.
+  // the others their surface's velocity), nearer than half of it every (2 stride)-th, and so on:
+  // an object's pixels grow as 1 / Z^2, the ones followed stay about as many. By absolute row and
+  // column, so tiles follow the same pixels.
   const int stride = p.pool_surface_motion ? p.chain_stride : 1;
   const float d_stride =
       stride > 1 ? static_cast<float>(cam.focal_px * cam.baseline_m / p.chain_stride_z_m)
                  : std::numeric_limits<float>::infinity();
+  auto followed = [stride, d_stride](int x, int y, float d) {
+    if (d < d_stride) return true;
+    int s = stride;
+    for (float next = 2.0f * d_stride; d >= next && s < kMaxChainStride; next *= 2.0f) s *= 2;
+    return y % s == 0 && x % s == 0;
+  };
   auto in_band = [&cam, &env](int y, float d) {
     const double Y = (y - cam.cy) * cam.baseline_m / d;  // (y - cy) * Z / f
     return Y >= env.y_top_m && Y <= env.y_bottom_m;
@@ -360,14 +369,13 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
     float* ttc_row = ttc.ptr<float>(y);
     cv::Vec3f* vel_row = velocity.ptr<cv::Vec3f>(y);
     live.clear();
-    const bool stride_row = y % stride == 0;
     const auto fy = static_cast<float>(y);
     for (int x = 0; x < disp_cur.cols; ++x) {
       danger_row[x] = 0;
       ttc_row[x] = kNaN;
       vel_row[x] = unknown;
       if (d_row[x] > 0.0f && d_row[x] >= d_min && edge_row[x] == 0 &&
-          (d_row[x] < d_stride || (stride_row && x % stride == 0)) &&
+          followed(x, y, d_row[x]) &&
           (!p.use_envelope_band || in_band(y, d_row[x]))) {
         q[x] = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
         live.push_back(x);
