@@ -28,8 +28,8 @@ int find_root(std::vector<int>& parent, int i) {
 /// Labels (CV_32S, 0 = none, 1..count-1) the 8-connected components of the `member` pixels
 /// (CV_8U nonzero) whose neighbours' disparities differ by at most `step`, also joining pixels of
 /// one column that far apart (see below); returns count.
-int label_continuous(const cv::Mat& disp, const cv::Mat& member, float step, double bridge_rows_per_px,
-                     cv::Mat& labels) {
+int label_continuous(const cv::Mat& disp, const cv::Mat& member, float step,
+                     double bridge_rows_per_px, cv::Mat& labels) {
   const int w = disp.cols, h = disp.rows;
   std::vector<int> parent(static_cast<size_t>(w) * static_cast<size_t>(h), -1);
   auto unite = [&parent](int a, int b) {
