@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "sg/core/error.hpp"
 #include "sg/vision/detector.hpp"
@@ -153,6 +155,15 @@ core::DetectorParams flow_params() {
   return p;
 }
 
+/// Stereo-Flow with these gaps and a signal on from the first dangerous frame.
+core::DetectorParams flow_params_at_once(std::vector<int> gaps) {
+  core::DetectorParams p = flow_params();
+  p.scene_flow.gaps = std::move(gaps);
+  p.signal.on_k = 1;
+  p.signal.on_n = 1;
+  return p;
+}
+
 /// The patch of kPatch moved by `shift_x` px since the last frame: backward flow (-shift_x, 0) on
 /// it, zero elsewhere (the background does not move).
 cv::Mat patch_flow(cv::Rect patch, float shift_x) {
@@ -227,11 +238,8 @@ TEST(DetectorStereoFlow, CrossingPatchNeverFiresWhereStereoModeDoes) {
 }
 
 TEST(DetectorStereoFlow, GapsNeedAnUnbrokenChainOfFlows) {
-  core::DetectorParams params = flow_params();
-  params.scene_flow.gaps = {2};
+  core::DetectorParams params = flow_params_at_once({2});
   params.scene_flow.fit_velocity = false;  // one gap's own semantics
-  params.signal.on_k = 1;
-  params.signal.on_n = 1;
   Detector det(params, camera());
   cv::RNG rng(13);
   std::vector<bool> dangerous;
@@ -257,11 +265,8 @@ TEST(DetectorStereoFlow, GapsNeedAnUnbrokenChainOfFlows) {
 // With the velocity fit (default), the samples carry their real times too.
 TEST(DetectorStereoFlow, DroppedFrameShortensTheChain) {
   for (bool fit : {false, true}) {
-    core::DetectorParams params = flow_params();
-    params.scene_flow.gaps = {2};
+    core::DetectorParams params = flow_params_at_once({2});
     params.scene_flow.fit_velocity = fit;
-    params.signal.on_k = 1;
-    params.signal.on_n = 1;
     Detector det(params, camera());
     cv::RNG rng(14);
     std::vector<bool> dangerous;
@@ -294,11 +299,8 @@ TEST(DetectorStereoFlow, DroppedFrameShortensTheChain) {
 // 3 s horizon).
 TEST(DetectorStereoFlow, TheFirstFramesOfAChainAlarmOnlyOnAnApproachClearOfTheirNoise) {
   auto dangerous_frames = [](double doubt_px, auto depth) {
-    core::DetectorParams params = flow_params();
-    params.scene_flow.gaps = {1, 10};
+    core::DetectorParams params = flow_params_at_once({1, 10});
     params.scene_flow.startup_doubt_px = doubt_px;
-    params.signal.on_k = 1;
-    params.signal.on_n = 1;
     Detector det(params, camera());
     cv::RNG rng(15);
     std::vector<int> frames;
