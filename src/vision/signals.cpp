@@ -2,31 +2,32 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
 #include "sg/core/error.hpp"
+#include "sg/vision/order_stats.hpp"
 
 namespace sg::vision {
 namespace {
 
-/// Median of `v` (reordered); the mean of the two middle values for an even count.
-double median_of(std::vector<double>& v) {
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  const double upper = v[mid];
-  if (v.size() % 2 == 1) return upper;
-  const double lower = *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid));
-  return 0.5 * (lower + upper);
-}
-
 struct Blob {
   cv::Point first{-1, -1};  ///< first pixel in raster order
-  std::vector<double> depths;
-  std::vector<double> ttcs;
+  std::vector<float> disparities;  ///< > 0
+  std::vector<float> ttcs;
   cv::Vec3d velocity_sum{0.0, 0.0, 0.0};
   int velocity_count = 0;
 };
+
+/// The median of the depths of `disparities` (> 0): depth falls as disparity grows, so the
+/// depths' middle ranks are the disparities' middle ranks, and no depth needs computing but those.
+double median_depth(const std::vector<float>& disparities, const core::Camera& camera) {
+  const size_t mid = disparities.size() / 2;
+  if (disparities.size() % 2 == 1) return camera.depth(kth_smallest(disparities, mid));
+  const auto [lower, upper] = adjacent_smallest(disparities, mid);
+  return 0.5 * (camera.depth(upper) + camera.depth(lower));
+}
 
 }  // namespace
 
@@ -46,7 +47,10 @@ std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp
   const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
 
   std::vector<Blob> blobs(static_cast<size_t>(count));
-  auto kept = [&](int label) { return stats.at<int>(label, cv::CC_STAT_AREA) >= p.min_area_px; };
+  std::vector<std::uint8_t> kept_blob(static_cast<size_t>(count), 0);
+  for (int l = 1; l < count; ++l)
+    kept_blob[static_cast<size_t>(l)] = stats.at<int>(l, cv::CC_STAT_AREA) >= p.min_area_px;
+  auto kept = [&kept_blob](int label) { return kept_blob[static_cast<size_t>(label)] != 0; };
   for (int y = 0; y < mask.rows; ++y) {
     const int* lab = labels.ptr<int>(y);
     const float* d = disp.ptr<float>(y);
@@ -61,8 +65,13 @@ std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp
         continue;
       }
       Blob& b = blobs[static_cast<size_t>(l)];
-      if (b.first.x < 0) b.first = {x, y};
-      if (d[x] > 0.0f) b.depths.push_back(camera.depth(d[x]));
+      if (b.first.x < 0) {
+        b.first = {x, y};
+        const auto area = static_cast<size_t>(stats.at<int>(l, cv::CC_STAT_AREA));
+        b.disparities.reserve(area);
+        b.ttcs.reserve(area);
+      }
+      if (d[x] > 0.0f) b.disparities.push_back(d[x]);
       if (std::isfinite(t[x])) b.ttcs.push_back(t[x]);
       if (v && std::isfinite(v[x][0]) && std::isfinite(v[x][1]) && std::isfinite(v[x][2])) {
         b.velocity_sum += cv::Vec3d(v[x]);
@@ -89,7 +98,7 @@ std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp
     o.bbox = cv::Rect(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
                       stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT));
     o.pixels = stats.at<int>(l, cv::CC_STAT_AREA);
-    o.distance_m = b.depths.empty() ? 0.0 : median_of(b.depths);
+    o.distance_m = b.disparities.empty() ? 0.0 : median_depth(b.disparities, camera);
     if (!b.ttcs.empty()) o.ttc_s = median_of(b.ttcs);
     if (b.velocity_count > 0) o.velocity = b.velocity_sum * (1.0 / b.velocity_count);
     out.push_back(o);
