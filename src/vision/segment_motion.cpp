@@ -25,11 +25,17 @@ int find_root(std::vector<int>& parent, int i) {
   return i;
 }
 
-/// Labels (CV_32S, 0 = none, 1..count-1) the 8-connected components of the `member` pixels
-/// (CV_8U nonzero) whose neighbours' disparities differ by at most `step`, also joining pixels of
-/// one column that far apart (see below); returns count.
-int label_continuous(const cv::Mat& disp, const cv::Mat& member, float step,
-                     double bridge_rows_per_px, cv::Mat& labels) {
+/// The inputs of label_surfaces: a CV_32F disparity and a CV_8U member mask of one size.
+void check_surface_inputs(const cv::Mat& disp, const cv::Mat& member) {
+  if (disp.type() != CV_32FC1 || member.type() != CV_8UC1 || member.size() != disp.size())
+    throw core::InputError("surfaces: a CV_32F disparity and a CV_8U member mask of one size");
+}
+
+}  // namespace
+
+int label_surfaces_reference(const cv::Mat& disp, const cv::Mat& member, float step,
+                             double bridge_rows_per_px, cv::Mat& labels) {
+  check_surface_inputs(disp, member);
   const int w = disp.cols, h = disp.rows;
   std::vector<int> parent(static_cast<size_t>(w) * static_cast<size_t>(h), -1);
   auto unite = [&parent](int a, int b) {
@@ -101,7 +107,103 @@ int label_continuous(const cv::Mat& disp, const cv::Mat& member, float step,
   return count;
 }
 
-}  // namespace
+
+int label_surfaces(const cv::Mat& disp, const cv::Mat& member, float step,
+                   double bridge_rows_per_px, cv::Mat& labels) {
+  check_surface_inputs(disp, member);
+  const int w = disp.cols, h = disp.rows;
+  // The nodes are segments: a row's runs of members whose left neighbours are continuous, so
+  // that the union-find holds thousands of nodes, not every pixel, and a pixel costs its
+  // comparisons only. Segments are made in raster order, as the reference meets pixels.
+  struct Segment {
+    int y, x0, x1;  ///< row, first and one past the last column
+  };
+  std::vector<Segment> segments;
+  std::vector<int> parent;
+  std::vector<int> above(static_cast<size_t>(w), -1), here(static_cast<size_t>(w), -1);
+  auto unite = [&parent](int a, int b) {
+    a = find_root(parent, a);
+    b = find_root(parent, b);
+    if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+  };
+  // The segment that the current one was last joined to: along a segment its pixels meet the
+  // same neighbouring segments over and over, and only the first meeting needs the union-find.
+  int joined = -1;
+  auto join = [&unite, &joined](int seg, int other) {
+    if (other == joined) return;
+    unite(seg, other);
+    joined = other;
+  };
+  // Per column, as in the reference, the few most recent runs of distinct disparity, now naming
+  // their segments.
+  struct Run {
+    int segment = -1, row = 0;
+    float d = 0.0f;
+  };
+  constexpr int kRuns = 3;
+  std::vector<Run> runs(bridge_rows_per_px > 0.0 ? static_cast<size_t>(w) * kRuns : 0);
+  for (int y = 0; y < h; ++y) {
+    const float* d = disp.ptr<float>(y);
+    const float* du = y > 0 ? disp.ptr<float>(y - 1) : nullptr;
+    const std::uint8_t* m = member.ptr<std::uint8_t>(y);
+    const std::uint8_t* mu = y > 0 ? member.ptr<std::uint8_t>(y - 1) : nullptr;
+    for (int x = 0; x < w; ++x) {
+      if (!m[x]) {
+        here[static_cast<size_t>(x)] = -1;
+        continue;
+      }
+      int seg = x > 0 ? here[static_cast<size_t>(x - 1)] : -1;
+      if (seg < 0 || std::abs(d[x - 1] - d[x]) > step) {
+        seg = static_cast<int>(segments.size());
+        segments.push_back({y, x, x + 1});
+        parent.push_back(seg);
+        joined = seg;
+      } else {
+        segments[static_cast<size_t>(seg)].x1 = x + 1;
+      }
+      here[static_cast<size_t>(x)] = seg;
+      if (mu) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int xx = x + dx;
+          if (xx < 0 || xx >= w || !mu[xx] || std::abs(du[xx] - d[x]) > step) continue;
+          join(seg, above[static_cast<size_t>(xx)]);
+        }
+      }
+      if (runs.empty()) continue;
+      Run* col = &runs[static_cast<size_t>(x) * kRuns];
+      Run* slot = nullptr;
+      const double reach = bridge_rows_per_px * d[x];
+      for (int k = 0; k < kRuns; ++k) {
+        Run& r = col[k];
+        if (r.segment >= 0 && y - r.row <= reach && std::abs(r.d - d[x]) <= step) {
+          join(seg, r.segment);
+          if (!slot) slot = &r;
+        }
+      }
+      if (!slot) {  // a new run: it replaces the one seen longest ago
+        slot = col;
+        for (int k = 1; k < kRuns; ++k)
+          if (col[k].segment < 0 || col[k].row < slot->row) slot = &col[k];
+      }
+      *slot = Run{seg, y, d[x]};
+    }
+    std::swap(above, here);
+  }
+  labels.create(disp.size(), CV_32SC1);
+  labels.setTo(0);
+  // Numbered as the reference numbers them: in the raster order of each surface's first pixel,
+  // which is the first pixel of its first segment.
+  std::vector<int> id(segments.size(), 0);
+  int count = 1;
+  for (size_t s = 0; s < segments.size(); ++s) {
+    const int r = find_root(parent, static_cast<int>(s));
+    if (id[static_cast<size_t>(r)] == 0) id[static_cast<size_t>(r)] = count++;
+    const Segment& g = segments[s];
+    int* l = labels.ptr<int>(g.y);
+    std::fill(l + g.x0, l + g.x1, id[static_cast<size_t>(r)]);
+  }
+  return count;
+}
 
 float interquartile_mean(std::vector<float>& v) {
   const size_t quarter = v.size() / 4;
@@ -150,7 +252,7 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
   }
   cv::Mat labels;
   // A gap of bridge_m at depth Z = f B / d spans bridge_m f / Z = (bridge_m / B) d rows.
-  const int count = label_continuous(disp, member, static_cast<float>(p.edge_step_px),
+  const int count = label_surfaces(disp, member, static_cast<float>(p.edge_step_px),
                                      p.surface_bridge_m / cam.baseline_m, labels);
   // Velocity components per surface, then their interquartile means.
   std::vector<std::vector<float>> vx(static_cast<size_t>(count)), vy(vx.size()), vz(vx.size());
@@ -171,7 +273,15 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
       pooled[s] = cv::Vec3f(interquartile_mean(vx[s]), interquartile_mean(vy[s]),
                             interquartile_mean(vz[s]));
 
+  // Per surface: whether its pixels are tested at all. Faster than max_speed_mps is a mismatch,
+  // and V keep can reach the envelope's approach speed v_min_mps > 0 only if V does
+  // (0 < keep <= 1).
   const double max_speed2 = p.max_speed_mps * p.max_speed_mps;
+  std::vector<std::uint8_t> tested(pooled.size(), 0);
+  for (size_t s = 1; s < pooled.size(); ++s) {
+    const cv::Vec3d V(pooled[s]);
+    tested[s] = finite(pooled[s]) && V.dot(V) <= max_speed2 && V[2] <= -p.v_min_mps;
+  }
   const double fb = cam.focal_px * cam.baseline_m;
   for (int y = 0; y < disp.rows; ++y) {
     const int* l = labels.ptr<int>(y);
@@ -183,12 +293,10 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
     for (int x = 0; x < disp.cols; ++x) {
       out[x] = 0;
       t[x] = kNaN;
-      if (l[x] == 0 || c[x] == 0 || !finite(pooled[static_cast<size_t>(l[x])])) {
-        v[x] = cv::Vec3f(kNaN, kNaN, kNaN);
-        continue;
-      }
-      const cv::Vec3d V(pooled[static_cast<size_t>(l[x])]);
-      v[x] = cv::Vec3f(V);
+      const auto s = static_cast<size_t>(l[x]);
+      v[x] = c[x] == 0 ? cv::Vec3f(kNaN, kNaN, kNaN) : pooled[s];  // pooled[0]: NaN
+      if (c[x] == 0 || !tested[s]) continue;
+      const cv::Vec3d V(pooled[s]);
       const cv::Point3d P = cam.point(x, y, d[x]);
       const double z_before = P.z - V[2] * span_s;
       const bool grew = z_before > 0.0 && d[x] - fb / z_before >= p.min_delta_d_px;
@@ -199,8 +307,7 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
         keep = 1.0 - sigma_v / -V[2];
       }
       double t_c = 0.0;
-      if (grew && keep > 0.0 && V.dot(V) <= max_speed2 &&
-          heads_into_envelope(P, V * keep, env, p.v_min_mps, t_c)) {
+      if (grew && keep > 0.0 && heads_into_envelope(P, V * keep, env, p.v_min_mps, t_c)) {
         out[x] = 255;
         t[x] = static_cast<float>(t_c * keep);  // the TTC of V itself
       }

@@ -228,5 +228,43 @@ TEST(InterquartileMean, AgreesWithTheSortingReference) {
   EXPECT_NEAR(by_sort(big), -1.4, 0.01);
 }
 
+// The run-based union-find against the pixel-based reference: the same labels and count on
+// random maps of surfaces at several depths, with holes, noise below and above the step, thin
+// columns cut by stretches of other disparities, and with and without bridging.
+TEST(LabelSurfaces, AgreesWithThePixelByPixelReference) {
+  cv::RNG rng(21);
+  for (int trial = 0; trial < 24; ++trial) {
+    const cv::Size size(97 + trial, 61 + 2 * trial);
+    cv::Mat disp(size, CV_32F), member(size, CV_8U);
+    // Blocks of one disparity each, a few levels apart or within the step of one another.
+    const int block = 4 + trial % 5;
+    for (int y = 0; y < size.height; ++y)
+      for (int x = 0; x < size.width; ++x) {
+        const int b = (y / block) * 31 + (x / (block + 3)) * 17;
+        const float level = static_cast<float>(10 + (b * 7919 % 5)) * (0.25f + 0.05f * trial);
+        disp.at<float>(y, x) = level + static_cast<float>(rng.gaussian(0.15));
+        member.at<uint8_t>(y, x) = rng.uniform(0.0, 1.0) < 0.85 ? 255 : 0;
+      }
+    // Thin posts cut into pieces by stretches of another disparity: what the bridge joins.
+    for (int x = 5; x < size.width; x += 23)
+      for (int y = 0; y < size.height; ++y) {
+        disp.at<float>(y, x) = (y / 6) % 3 == 0 ? 2.0f : 30.0f;
+        member.at<uint8_t>(y, x) = 255;
+      }
+    const float step = trial % 2 == 0 ? 0.5f : 1.0f;
+    for (const double bridge : {0.0, 0.2, 1.5}) {
+      cv::Mat fast, reference;
+      const int n_fast = label_surfaces(disp, member, step, bridge, fast);
+      const int n_reference = label_surfaces_reference(disp, member, step, bridge, reference);
+      EXPECT_EQ(n_fast, n_reference) << "trial " << trial << " bridge " << bridge;
+      EXPECT_EQ(cv::countNonZero(fast != reference), 0) << "trial " << trial << " bridge " << bridge;
+      EXPECT_GT(n_fast, 2) << trial;  // surfaces to tell apart, not one or none
+    }
+  }
+  cv::Mat labels;
+  EXPECT_THROW(label_surfaces(cv::Mat(4, 4, CV_32F), cv::Mat(4, 5, CV_8U), 1.0f, 0.0, labels),
+               core::InputError);
+}
+
 }  // namespace
 }  // namespace sg::vision

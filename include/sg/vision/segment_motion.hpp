@@ -25,6 +25,20 @@ namespace sg::vision {
 /// the sorted one, so it may differ from that by a float rounding (the test's reference sorts).
 float interquartile_mean(std::vector<float>& v);
 
+/// The surfaces of pool_surface_motion: labels (CV_32S, 0 = none, 1..count-1, numbered in the
+/// raster order of each surface's first pixel) the 8-connected components of the `member` pixels
+/// (CV_8U nonzero) whose neighbours' disparities (disp, CV_32F) differ by at most `step`, also
+/// joining a member to one of the last three runs of distinct disparity in its column when that
+/// run ended at most bridge_rows_per_px * d rows above and its disparity was within `step`
+/// (0 = no bridging). Returns count. A union-find over each row's runs of continuous members.
+int label_surfaces(const cv::Mat& disp, const cv::Mat& member, float step,
+                   double bridge_rows_per_px, cv::Mat& labels);
+
+/// The same, pixel by pixel (a union-find over every member): the reference label_surfaces is
+/// tested against.
+int label_surfaces_reference(const cv::Mat& disp, const cv::Mat& member, float step,
+                             double bridge_rows_per_px, cv::Mat& labels);
+
 /// Relabels a Stereo-Flow frame with pooled velocities. Surfaces are the 8-connected components
 /// of the pixels with a valid disparity (disp, CV_32F, invalid < 0), Z <= p.z_max_m and, with
 /// p.use_envelope_band, inside the envelope's vertical band now, where neighbours' disparities
