@@ -144,7 +144,16 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
 
   // Port 0: the item's first tasks are done (to the relay, or to the collector without one);
   // port 1: its relay tasks are done (to the collector).
-  using FarmNode = flow::multifunction_node<TaskMsg, std::tuple<std::size_t, std::size_t>>;
+  // A worker that comes free takes the oldest item's task first: a frame's labelling (the relay's
+  // tasks) does not wait behind the next frame's stereo and flow tasks that were queued before it,
+  // so the frames in flight finish as they arrived instead of all finishing late. The farm
+  // rejects what it cannot run at once, and the queue in front of it hands over by priority.
+  struct NewerIsLess {
+    bool operator()(const TaskMsg& a, const TaskMsg& b) const { return a.seq > b.seq; }
+  };
+  flow::priority_queue_node<TaskMsg, NewerIsLess> pending(graph);
+  using FarmNode =
+      flow::multifunction_node<TaskMsg, std::tuple<std::size_t, std::size_t>, flow::rejecting>;
   FarmNode farm(graph, static_cast<std::size_t>(config.workers),
                 [&](const TaskMsg& msg, FarmNode::output_ports_type& ports) {
                   HandoffScope scope;
@@ -212,13 +221,14 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
 
   flow::make_edge(ticks, limiter);
   flow::make_edge(limiter, emit);
-  flow::make_edge(flow::output_port<0>(emit), farm);
+  flow::make_edge(flow::output_port<0>(emit), pending);
+  flow::make_edge(pending, farm);
   if (cb.relay) {
     // Items without first tasks go through the relay too.
     flow::make_edge(flow::output_port<1>(emit), relay_sequencer);
     flow::make_edge(flow::output_port<0>(farm), relay_sequencer);
     flow::make_edge(relay_sequencer, relay);
-    flow::make_edge(flow::output_port<0>(relay), farm);
+    flow::make_edge(flow::output_port<0>(relay), pending);
     flow::make_edge(flow::output_port<1>(relay), sequencer);
     flow::make_edge(flow::output_port<1>(farm), sequencer);
   } else {

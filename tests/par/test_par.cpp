@@ -454,6 +454,38 @@ TEST_P(FarmTest, ExceptionsStopTheRunAndPropagate) {
 
 INSTANTIATE_TEST_SUITE_P(Backends, FarmTest, testing::ValuesIn(kCases), case_name);
 
+// A worker that comes free takes the oldest item's task: item 0's relay task, queued while item
+// 1's first two tasks waited, runs before the second of them (first in, first out would run both
+// of item 1's first). One worker, two items in flight, two threads so that the relay runs while
+// the worker sleeps in item 1's first task.
+TEST(FarmOrderTest, AFreeWorkerTakesTheOldestItemsTaskFirst) {
+  const FarmConfig config{Backend::kTbb, 1, 2, 2};
+  std::mutex mutex;
+  std::vector<std::string> ran;
+  auto note = [&](const std::string& what) {
+    const std::lock_guard<std::mutex> lock(mutex);
+    ran.push_back(what);
+  };
+  int next = 0;
+  run_ordered_farm_relay(
+      config,
+      [&]() -> std::optional<int> { return next < 2 ? std::optional(next++) : std::nullopt; },
+      [&](int& item) -> TaskList {
+        if (item == 0) return {[&] { note("first 0"); }};
+        return {[&] {
+                  pause_us(200000);  // long enough for item 0's relay to queue its task
+                  note("first 1a");
+                },
+                [&] { note("first 1b"); }};
+      },
+      [&](int& item) -> TaskList {
+        return {[&note, item] { note("relay " + std::to_string(item)); }};
+      },
+      [](int&&) {});
+  const std::vector<std::string> expected{"first 0", "first 1a", "relay 0", "first 1b", "relay 1"};
+  EXPECT_EQ(ran, expected);
+}
+
 TEST(FarmConfigTest, ValidateNamesEachBadField) {
   EXPECT_TRUE(validate(FarmConfig{}).empty());
   const std::vector<std::string> problems = validate(FarmConfig{Backend::kTbb, 0, 0, -1});
