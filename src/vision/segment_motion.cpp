@@ -25,6 +25,13 @@ int find_root(std::vector<int>& parent, int i) {
   return i;
 }
 
+/// Joins the sets of a and b under the smaller root.
+void unite_roots(std::vector<int>& parent, int a, int b) {
+  a = find_root(parent, a);
+  b = find_root(parent, b);
+  if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+}
+
 /// The inputs of label_surfaces: a CV_32F disparity and a CV_8U member mask of one size.
 void check_surface_inputs(const cv::Mat& disp, const cv::Mat& member) {
   if (disp.type() != CV_32FC1 || member.type() != CV_8UC1 || member.size() != disp.size())
@@ -38,11 +45,7 @@ int label_surfaces_reference(const cv::Mat& disp, const cv::Mat& member, float s
   check_surface_inputs(disp, member);
   const int w = disp.cols, h = disp.rows;
   std::vector<int> parent(static_cast<size_t>(w) * static_cast<size_t>(h), -1);
-  auto unite = [&parent](int a, int b) {
-    a = find_root(parent, a);
-    b = find_root(parent, b);
-    if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
-  };
+  auto unite = [&parent](int a, int b) { unite_roots(parent, a, b); };
   // Per column, the last pixels of the few most recent runs of distinct disparity (index, row,
   // disparity): a run that resumes within bridge_rows_per_px * d rows at a similar disparity d is
   // the same surface seen past a stretch the matcher got wrong or left out.
@@ -107,7 +110,6 @@ int label_surfaces_reference(const cv::Mat& disp, const cv::Mat& member, float s
   return count;
 }
 
-
 int label_surfaces(const cv::Mat& disp, const cv::Mat& member, float step,
                    double bridge_rows_per_px, cv::Mat& labels) {
   check_surface_inputs(disp, member);
@@ -121,11 +123,7 @@ int label_surfaces(const cv::Mat& disp, const cv::Mat& member, float step,
   std::vector<Segment> segments;
   std::vector<int> parent;
   std::vector<int> above(static_cast<size_t>(w), -1), here(static_cast<size_t>(w), -1);
-  auto unite = [&parent](int a, int b) {
-    a = find_root(parent, a);
-    b = find_root(parent, b);
-    if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
-  };
+  auto unite = [&parent](int a, int b) { unite_roots(parent, a, b); };
   // The segment that the current one was last joined to: along a segment its pixels meet the
   // same neighbouring segments over and over, and only the first meeting needs the union-find.
   int joined = -1;
@@ -253,7 +251,7 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
   cv::Mat labels;
   // A gap of bridge_m at depth Z = f B / d spans bridge_m f / Z = (bridge_m / B) d rows.
   const int count = label_surfaces(disp, member, static_cast<float>(p.edge_step_px),
-                                     p.surface_bridge_m / cam.baseline_m, labels);
+                                   p.surface_bridge_m / cam.baseline_m, labels);
   // Velocity components per surface, then their interquartile means.
   std::vector<std::vector<float>> vx(static_cast<size_t>(count)), vy(vx.size()), vz(vx.size());
   for (int y = 0; y < disp.rows; ++y) {
