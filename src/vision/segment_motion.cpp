@@ -32,6 +32,38 @@ void unite_roots(std::vector<int>& parent, int a, int b) {
   if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
 }
 
+/// The last pixels of a column's few most recent runs of distinct disparity: a run that resumes
+/// within bridge_rows_per_px * d rows at a similar disparity d is the same surface seen past a
+/// stretch the matcher got wrong or left out. `node` names the union-find node of the pixel (a
+/// pixel in the reference, a row segment in label_surfaces).
+struct Run {
+  int node = -1, row = 0;
+  float d = 0.0f;
+};
+constexpr int kRuns = 3;
+
+/// Bridges the member at row y with disparity d (union-find node `node`) to the runs of its
+/// column `col` (kRuns entries) that ended within `reach` rows at a disparity within `step`, by
+/// join(node, other); then records it in the run it continues, or in place of the one seen
+/// longest ago.
+template <class Join>
+void bridge_column(Run* col, int y, float d, double reach, float step, int node, Join&& join) {
+  Run* slot = nullptr;
+  for (int k = 0; k < kRuns; ++k) {
+    Run& r = col[k];
+    if (r.node >= 0 && y - r.row <= reach && std::abs(r.d - d) <= step) {
+      join(node, r.node);
+      if (!slot) slot = &r;
+    }
+  }
+  if (!slot) {  // a new run: it replaces the one seen longest ago
+    slot = col;
+    for (int k = 1; k < kRuns; ++k)
+      if (col[k].node < 0 || col[k].row < slot->row) slot = &col[k];
+  }
+  *slot = Run{node, y, d};
+}
+
 /// The inputs of label_surfaces: a CV_32F disparity and a CV_8U member mask of one size.
 void check_surface_inputs(const cv::Mat& disp, const cv::Mat& member) {
   if (disp.type() != CV_32FC1 || member.type() != CV_8UC1 || member.size() != disp.size())
@@ -46,14 +78,7 @@ int label_surfaces_reference(const cv::Mat& disp, const cv::Mat& member, float s
   const int w = disp.cols, h = disp.rows;
   std::vector<int> parent(static_cast<size_t>(w) * static_cast<size_t>(h), -1);
   auto unite = [&parent](int a, int b) { unite_roots(parent, a, b); };
-  // Per column, the last pixels of the few most recent runs of distinct disparity (index, row,
-  // disparity): a run that resumes within bridge_rows_per_px * d rows at a similar disparity d is
-  // the same surface seen past a stretch the matcher got wrong or left out.
-  struct Run {
-    int index = -1, row = 0;
-    float d = 0.0f;
-  };
-  constexpr int kRuns = 3;
+  // Per column, the last pixels of its few most recent runs (bridge_column).
   std::vector<Run> runs(bridge_rows_per_px > 0.0 ? static_cast<size_t>(w) * kRuns : 0);
   for (int y = 0; y < h; ++y) {
     const float* d = disp.ptr<float>(y);
@@ -73,22 +98,8 @@ int label_surfaces_reference(const cv::Mat& disp, const cv::Mat& member, float s
         }
       }
       if (runs.empty()) continue;
-      Run* col = &runs[static_cast<size_t>(x) * kRuns];
-      Run* slot = nullptr;
-      const double reach = bridge_rows_per_px * d[x];
-      for (int k = 0; k < kRuns; ++k) {
-        Run& r = col[k];
-        if (r.index >= 0 && y - r.row <= reach && std::abs(r.d - d[x]) <= step) {
-          unite(i, r.index);
-          if (!slot) slot = &r;
-        }
-      }
-      if (!slot) {  // a new run: it replaces the one seen longest ago
-        slot = col;
-        for (int k = 1; k < kRuns; ++k)
-          if (col[k].index < 0 || col[k].row < slot->row) slot = &col[k];
-      }
-      *slot = Run{i, y, d[x]};
+      bridge_column(&runs[static_cast<size_t>(x) * kRuns], y, d[x], bridge_rows_per_px * d[x],
+                    step, i, unite);
     }
   }
   labels.create(disp.size(), CV_32SC1);
@@ -132,13 +143,7 @@ int label_surfaces(const cv::Mat& disp, const cv::Mat& member, float step,
     unite(seg, other);
     joined = other;
   };
-  // Per column, as in the reference, the few most recent runs of distinct disparity, now naming
-  // their segments.
-  struct Run {
-    int segment = -1, row = 0;
-    float d = 0.0f;
-  };
-  constexpr int kRuns = 3;
+  // Per column, as in the reference, its few most recent runs (bridge_column), naming segments.
   std::vector<Run> runs(bridge_rows_per_px > 0.0 ? static_cast<size_t>(w) * kRuns : 0);
   for (int y = 0; y < h; ++y) {
     const float* d = disp.ptr<float>(y);
@@ -168,22 +173,8 @@ int label_surfaces(const cv::Mat& disp, const cv::Mat& member, float step,
         }
       }
       if (runs.empty()) continue;
-      Run* col = &runs[static_cast<size_t>(x) * kRuns];
-      Run* slot = nullptr;
-      const double reach = bridge_rows_per_px * d[x];
-      for (int k = 0; k < kRuns; ++k) {
-        Run& r = col[k];
-        if (r.segment >= 0 && y - r.row <= reach && std::abs(r.d - d[x]) <= step) {
-          join(seg, r.segment);
-          if (!slot) slot = &r;
-        }
-      }
-      if (!slot) {  // a new run: it replaces the one seen longest ago
-        slot = col;
-        for (int k = 1; k < kRuns; ++k)
-          if (col[k].segment < 0 || col[k].row < slot->row) slot = &col[k];
-      }
-      *slot = Run{seg, y, d[x]};
+      bridge_column(&runs[static_cast<size_t>(x) * kRuns], y, d[x], bridge_rows_per_px * d[x],
+                    step, seg, join);
     }
     std::swap(above, here);
   }
