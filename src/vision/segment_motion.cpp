@@ -8,6 +8,7 @@
 
 #include "sg/core/error.hpp"
 #include "sg/vision/scene_flow.hpp"
+#include "sg/vision/surface_test.hpp"
 
 namespace sg::vision {
 namespace {
@@ -271,7 +272,8 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
     const cv::Vec3d V(pooled[s]);
     tested[s] = finite(pooled[s]) && V.dot(V) <= max_speed2 && V[2] <= -p.v_min_mps;
   }
-  const double fb = cam.focal_px * cam.baseline_m;
+  // Every candidate of a tested surface, a run of one surface's pixels at a time (SIMD).
+  const SurfaceTest test = make_surface_test(cam, env, p, span_s, time_spread_s2);
   for (int y = 0; y < disp.rows; ++y) {
     const int* l = labels.ptr<int>(y);
     const float* d = disp.ptr<float>(y);
@@ -279,26 +281,18 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
     float* t = ttc.ptr<float>(y);
     cv::Vec3f* v = velocity.ptr<cv::Vec3f>(y);
     const std::uint8_t* c = candidate.ptr<std::uint8_t>(y);
-    for (int x = 0; x < disp.cols; ++x) {
-      out[x] = 0;
-      t[x] = kNaN;
+    for (int x = 0; x < disp.cols;) {
       const auto s = static_cast<size_t>(l[x]);
-      v[x] = c[x] == 0 ? cv::Vec3f(kNaN, kNaN, kNaN) : pooled[s];  // pooled[0]: NaN
-      if (c[x] == 0 || !tested[s]) continue;
-      const cv::Vec3d V(pooled[s]);
-      const cv::Point3d P = cam.point(x, y, d[x]);
-      const double z_before = P.z - V[2] * span_s;
-      const bool grew = z_before > 0.0 && d[x] - fb / z_before >= p.min_delta_d_px;
-      // A short chain: the slowest approach along the same path that its error allows decides.
-      double keep = 1.0;
-      if (time_spread_s2 > 0.0 && V[2] < 0.0) {
-        const double sigma_v = P.z * p.startup_doubt_px / d[x] / std::sqrt(time_spread_s2);
-        keep = 1.0 - sigma_v / -V[2];
-      }
-      double t_c = 0.0;
-      if (grew && keep > 0.0 && heads_into_envelope(P, V * keep, env, p.v_min_mps, t_c)) {
-        out[x] = 255;
-        t[x] = static_cast<float>(t_c * keep);  // the TTC of V itself
+      int end = x + 1;
+      while (end < disp.cols && l[end] == l[x]) ++end;
+      if (tested[s])
+        test_surface_run(test, cv::Vec3d(pooled[s]), y, x, end, d, t);
+      else
+        std::fill(t + x, t + end, kNaN);
+      for (; x < end; ++x) {
+        v[x] = c[x] == 0 ? cv::Vec3f(kNaN, kNaN, kNaN) : pooled[s];  // pooled[0]: NaN
+        if (c[x] == 0) t[x] = kNaN;  // on the depth-edge margin: never dangerous
+        out[x] = std::isnan(t[x]) ? 0 : 255;
       }
     }
   }

@@ -1,0 +1,148 @@
+// The envelope test of pool_surface_motion: a SIMD kernel (Google Highway, compiled once per x86
+// target and dispatched at run time) beside its scalar reference. This file is compiled with
+// -ffp-contract=off (CMakeLists.txt): a fused multiply-add rounds once where the reference rounds
+// twice, and the kernel must equal the reference bit for bit.
+#include "sg/vision/surface_test.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "sg/vision/scene_flow.hpp"
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "src/vision/surface_test.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace sg::vision::surface_detail {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+/// Whole vectors of test_surface_run from x0; returns where the scalar tail starts. The
+/// operations are those of test_surface_run_reference, lane by lane, in the same order.
+int TestRunVectors(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
+                   const float* d, float* ttc) {
+  const hn::ScalableTag<double> dd;
+  const hn::Rebind<float, decltype(dd)> df;
+  const int n = static_cast<int>(hn::Lanes(dd));
+  const auto zero = hn::Zero(dd);
+  const auto one = hn::Set(dd, 1.0);
+  const auto nan = hn::Set(dd, std::numeric_limits<double>::quiet_NaN());
+  const auto cx = hn::Set(dd, k.cx);
+  const auto focal = hn::Set(dd, k.focal_px);
+  const auto fb = hn::Set(dd, k.fb);
+  const auto y_off = hn::Set(dd, y - k.cy);
+  const auto vz_span = hn::Set(dd, V[2] * k.span_s);
+  const auto min_delta = hn::Set(dd, k.min_delta_d_px);
+  // Without doubt, sigma_V = ((Z 0) / d) / 1 = 0 and keep = 1 - 0 / 1 = 1 exactly, as in the
+  // reference, and no branch: GCC 12 if-converted one here into AVX-512 masked operations whose
+  // mask it set from the bool (0 or 1), so that only lane 0 took the doubt.
+  const bool doubt = k.sqrt_time_spread > 0.0 && V[2] < 0.0;
+  const auto doubt_px = hn::Set(dd, doubt ? k.startup_doubt_px : 0.0);
+  const auto sqrt_spread = hn::Set(dd, doubt ? k.sqrt_time_spread : 1.0);
+  const auto approach = hn::Set(dd, doubt ? -V[2] : 1.0);
+  const auto vx = hn::Set(dd, V[0]), vy = hn::Set(dd, V[1]), vz = hn::Set(dd, V[2]);
+  const auto neg_v_min = hn::Set(dd, -k.v_min_mps);
+  const auto z_contact = hn::Set(dd, k.envelope.z_contact_m);
+  const auto horizon = hn::Set(dd, k.envelope.horizon_s);
+  const auto half_width = hn::Set(dd, k.envelope.half_width_m);
+  const auto y_top = hn::Set(dd, k.envelope.y_top_m);
+  const auto y_bottom = hn::Set(dd, k.envelope.y_bottom_m);
+  int x = x0;
+  for (; x + n <= x1; x += n) {
+    const auto disp = hn::PromoteTo(dd, hn::LoadU(df, d + x));
+    const auto z = hn::Div(fb, disp);
+    const auto px = hn::Div(hn::Mul(hn::Sub(hn::Iota(dd, static_cast<double>(x)), cx), z), focal);
+    const auto py = hn::Div(hn::Mul(y_off, z), focal);
+    const auto z_before = hn::Sub(z, vz_span);
+    const auto sigma_v = hn::Div(hn::Div(hn::Mul(z, doubt_px), disp), sqrt_spread);
+    const auto keep = hn::Sub(one, hn::Div(sigma_v, approach));
+    const auto kvz = hn::Mul(vz, keep);
+    const auto t_c = hn::Div(hn::Sub(z, z_contact), hn::Neg(kvz));
+    const auto ex = hn::Add(px, hn::Mul(hn::Mul(vx, keep), t_c));
+    const auto ey = hn::Add(py, hn::Mul(hn::Mul(vy, keep), t_c));
+    // Each failed condition turns the lane's TTC into NaN; the negated ones (> instead of <=)
+    // fail on NaN as the reference's do.
+    auto t = hn::Mul(t_c, keep);
+    t = hn::IfThenElse(hn::Gt(z_before, zero), t, nan);
+    t = hn::IfThenElse(hn::Ge(hn::Sub(disp, hn::Div(fb, z_before)), min_delta), t, nan);
+    t = hn::IfThenElse(hn::Gt(keep, zero), t, nan);
+    t = hn::IfThenElse(hn::Le(kvz, neg_v_min), t, nan);
+    t = hn::IfThenElse(hn::Gt(t_c, zero), t, nan);
+    t = hn::IfThenElse(hn::Gt(t_c, horizon), nan, t);
+    t = hn::IfThenElse(hn::Gt(hn::Abs(ex), half_width), nan, t);
+    t = hn::IfThenElse(hn::Lt(ey, y_top), nan, t);
+    t = hn::IfThenElse(hn::Gt(ey, y_bottom), nan, t);
+    hn::StoreU(hn::DemoteTo(df, t), df, ttc + x);
+  }
+  return x;
+}
+
+std::int64_t CurrentTarget() { return HWY_TARGET; }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace sg::vision::surface_detail
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace sg::vision {
+namespace surface_detail {
+HWY_EXPORT(TestRunVectors);
+HWY_EXPORT(CurrentTarget);
+}  // namespace surface_detail
+
+SurfaceTest make_surface_test(const core::Camera& cam, const core::Envelope& env,
+                              const core::SceneFlowParams& p, double span_s,
+                              double time_spread_s2) {
+  SurfaceTest k;
+  k.cx = cam.cx;
+  k.cy = cam.cy;
+  k.focal_px = cam.focal_px;
+  k.fb = cam.focal_px * cam.baseline_m;
+  k.span_s = span_s;
+  k.min_delta_d_px = p.min_delta_d_px;
+  k.v_min_mps = p.v_min_mps;
+  k.envelope = env;
+  if (time_spread_s2 > 0.0) {
+    k.startup_doubt_px = p.startup_doubt_px;
+    k.sqrt_time_spread = std::sqrt(time_spread_s2);
+  }
+  return k;
+}
+
+void test_surface_run_reference(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
+                                const float* d, float* ttc) {
+  const bool doubt = k.sqrt_time_spread > 0.0 && V[2] < 0.0;
+  for (int x = x0; x < x1; ++x) {
+    ttc[x] = std::numeric_limits<float>::quiet_NaN();
+    const double disp = d[x];
+    const double z = k.fb / disp;
+    const cv::Point3d P((x - k.cx) * z / k.focal_px, (y - k.cy) * z / k.focal_px, z);
+    const double z_before = z - V[2] * k.span_s;
+    if (!(z_before > 0.0 && disp - k.fb / z_before >= k.min_delta_d_px)) continue;
+    // A short chain: the slowest approach along the same path that its error allows decides.
+    double keep = 1.0;
+    if (doubt) {
+      const double sigma_v = z * k.startup_doubt_px / disp / k.sqrt_time_spread;
+      keep = 1.0 - sigma_v / -V[2];
+    }
+    double t_c = 0.0;
+    if (keep > 0.0 && heads_into_envelope(P, V * keep, k.envelope, k.v_min_mps, t_c))
+      ttc[x] = static_cast<float>(t_c * keep);  // the TTC of V itself
+  }
+}
+
+void test_surface_run(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
+                      const float* d, float* ttc) {
+  const int tail = HWY_DYNAMIC_DISPATCH(surface_detail::TestRunVectors)(k, V, y, x0, x1, d, ttc);
+  test_surface_run_reference(k, V, y, tail, x1, d, ttc);
+}
+
+std::string surface_test_target() {
+  return hwy::TargetName(HWY_DYNAMIC_DISPATCH(surface_detail::CurrentTarget)());
+}
+
+}  // namespace sg::vision
+#endif  // HWY_ONCE
