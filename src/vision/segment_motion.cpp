@@ -9,28 +9,16 @@
 #include "sg/core/error.hpp"
 #include "sg/vision/scene_flow.hpp"
 #include "sg/vision/surface_test.hpp"
+#include "union_find.hpp"
 
 namespace sg::vision {
 namespace {
 
+using detail::find_root;
+using detail::unite_roots;
+
 bool finite(const cv::Vec3f& v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
-}
-
-/// Union-find root with path halving.
-int find_root(std::vector<int>& parent, int i) {
-  while (parent[static_cast<size_t>(i)] != i) {
-    parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
-    i = parent[static_cast<size_t>(i)];
-  }
-  return i;
-}
-
-/// Joins the sets of a and b under the smaller root.
-void unite_roots(std::vector<int>& parent, int a, int b) {
-  a = find_root(parent, a);
-  b = find_root(parent, b);
-  if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
 }
 
 /// The last pixels of a column's few most recent runs of distinct disparity: a run that resumes

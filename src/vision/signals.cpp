@@ -7,13 +7,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sg/core/error.hpp"
+#include "sg/vision/components.hpp"
 #include "sg/vision/order_stats.hpp"
 
 namespace sg::vision {
 namespace {
 
 struct Blob {
-  cv::Point first{-1, -1};  ///< first pixel in raster order
   std::vector<float> disparities;  ///< > 0
   std::vector<float> ttcs;
   cv::Vec3d velocity_sum{0.0, 0.0, 0.0};
@@ -43,34 +43,31 @@ std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp
         cv::getStructuringElement(cv::MORPH_RECT, cv::Size(p.open_size, p.open_size));
     cv::morphologyEx(mask, mask, cv::MORPH_OPEN, kernel);
   }
-  cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<ComponentRun> runs;
+  std::vector<ComponentStats> stats;
+  const int count = connected_runs(mask, runs, stats);
 
   std::vector<Blob> blobs(static_cast<size_t>(count));
   std::vector<std::uint8_t> kept_blob(static_cast<size_t>(count), 0);
   for (int l = 1; l < count; ++l)
-    kept_blob[static_cast<size_t>(l)] = stats.at<int>(l, cv::CC_STAT_AREA) >= p.min_area_px;
-  auto kept = [&kept_blob](int label) { return kept_blob[static_cast<size_t>(label)] != 0; };
-  for (int y = 0; y < mask.rows; ++y) {
-    const int* lab = labels.ptr<int>(y);
-    const float* d = disp.ptr<float>(y);
-    const float* t = ttc.ptr<float>(y);
-    const cv::Vec3f* v = with_velocity ? velocity.ptr<cv::Vec3f>(y) : nullptr;
-    uchar* m = mask.ptr<uchar>(y);
-    for (int x = 0; x < mask.cols; ++x) {
-      const int l = lab[x];
-      if (l == 0) continue;
-      if (!kept(l)) {
-        m[x] = 0;
-        continue;
-      }
-      Blob& b = blobs[static_cast<size_t>(l)];
-      if (b.first.x < 0) {
-        b.first = {x, y};
-        const auto area = static_cast<size_t>(stats.at<int>(l, cv::CC_STAT_AREA));
-        b.disparities.reserve(area);
-        b.ttcs.reserve(area);
-      }
+    kept_blob[static_cast<size_t>(l)] = stats[static_cast<size_t>(l)].area >= p.min_area_px;
+  // Run by run in raster order: each blob's pixels come in raster order, as in a pixel scan.
+  for (const ComponentRun& run : runs) {
+    uchar* m = mask.ptr<uchar>(run.y);
+    if (!kept_blob[static_cast<size_t>(run.label)]) {
+      std::fill(m + run.x0, m + run.x1, 0);
+      continue;
+    }
+    Blob& b = blobs[static_cast<size_t>(run.label)];
+    if (b.disparities.capacity() == 0) {
+      const auto area = static_cast<size_t>(stats[static_cast<size_t>(run.label)].area);
+      b.disparities.reserve(area);
+      b.ttcs.reserve(area);
+    }
+    const float* d = disp.ptr<float>(run.y);
+    const float* t = ttc.ptr<float>(run.y);
+    const cv::Vec3f* v = with_velocity ? velocity.ptr<cv::Vec3f>(run.y) : nullptr;
+    for (int x = run.x0; x < run.x1; ++x) {
       if (d[x] > 0.0f) b.disparities.push_back(d[x]);
       if (std::isfinite(t[x])) b.ttcs.push_back(t[x]);
       if (v && std::isfinite(v[x][0]) && std::isfinite(v[x][1]) && std::isfinite(v[x][2])) {
@@ -80,24 +77,14 @@ std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp
     }
   }
 
-  // connectedComponents numbers blobs in its own scan order (block-based); sort by first pixel.
-  std::vector<int> order;
-  for (int l = 1; l < count; ++l)
-    if (kept(l)) order.push_back(l);
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    const cv::Point pa = blobs[static_cast<size_t>(a)].first;
-    const cv::Point pb = blobs[static_cast<size_t>(b)].first;
-    return pa.y != pb.y ? pa.y < pb.y : pa.x < pb.x;
-  });
-
+  // Labels are numbered in the raster order of the blobs' first pixels.
   std::vector<core::Obstacle> out;
-  out.reserve(order.size());
-  for (int l : order) {
+  for (int l = 1; l < count; ++l) {
+    if (!kept_blob[static_cast<size_t>(l)]) continue;
     Blob& b = blobs[static_cast<size_t>(l)];
     core::Obstacle o;
-    o.bbox = cv::Rect(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
-                      stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT));
-    o.pixels = stats.at<int>(l, cv::CC_STAT_AREA);
+    o.bbox = stats[static_cast<size_t>(l)].bbox;
+    o.pixels = stats[static_cast<size_t>(l)].area;
     o.distance_m = b.disparities.empty() ? 0.0 : median_depth(b.disparities, camera);
     if (!b.ttcs.empty()) o.ttc_s = median_of(b.ttcs);
     if (b.velocity_count > 0) o.velocity = b.velocity_sum * (1.0 / b.velocity_count);
