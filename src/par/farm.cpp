@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <cstddef>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <tuple>
@@ -76,13 +77,22 @@ struct Slot {
   std::atomic<std::size_t> remaining{0};  // tasks not yet finished
   std::atomic<std::size_t> relayed{0};    // seq + 1 once the relay replaced the tasks
   std::atomic<bool> free{true};
+  bool completed = false;  // all its tasks are done; guarded by the collection lock
 };
+
+/// What a message to the farm asks for: a task of an item's first round or of its relay's round,
+/// or (just-in-time admission) leave to emit the next item, queued behind every task.
+enum Phase : int { kFirstTasks = 0, kRelayTasks = 1, kAdmit = 2 };
 
 struct TaskMsg {
   std::size_t seq = 0;
   std::size_t task = 0;
-  int phase = 0;  // 0: the emitter's tasks, 1: the relay's
+  int phase = kFirstTasks;
 };
+
+/// The leave to emit: the largest sequence number, so that in the farm's queue it comes after
+/// every item's tasks.
+constexpr TaskMsg kAdmitMsg{std::numeric_limits<std::size_t>::max(), 0, kAdmit};
 
 void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   const auto tokens = static_cast<std::size_t>(config.tokens);
@@ -94,21 +104,100 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   // emitter (collector) calls on different threads visible to ThreadSanitizer.
   std::mutex emit_mutex;
   std::mutex relay_mutex;
-  std::mutex collect_mutex;
 
   flow::graph graph;
-  flow::input_node<int> ticks(graph, [&ended](tbb::flow_control& control) {
+  // A tick per item to emit while the stream lasts; it passes the limiter with a token.
+  flow::input_node<TaskMsg> ticks(graph, [&ended](tbb::flow_control& control) {
     HandoffScope scope;
     if (ended.load(std::memory_order_acquire)) control.stop();
-    return 0;
+    return kAdmitMsg;
   });
-  flow::limiter_node<int, int> limiter(graph, tokens);
+  flow::limiter_node<TaskMsg, int> limiter(graph, tokens);
   auto give_back_token = [&limiter] { limiter.decrementer().try_put(1); };
 
-  using EmitNode = flow::multifunction_node<int, std::tuple<TaskMsg, std::size_t>>;
-  EmitNode emit(graph, flow::serial, [&](int, EmitNode::output_ports_type& ports) {
+  // A worker that comes free takes the oldest item's task first: a frame's labelling (the relay's
+  // tasks) does not wait behind the next frame's stereo and flow tasks that were queued before it,
+  // so the frames in flight finish as they arrived instead of all finishing late. The farm
+  // rejects what it cannot run at once, and the queue in front of it hands over by priority.
+  struct NewerIsLess {
+    bool operator()(const TaskMsg& a, const TaskMsg& b) const { return a.seq > b.seq; }
+  };
+  flow::priority_queue_node<TaskMsg, NewerIsLess> pending(graph);
+
+  // Just-in-time admission: items emitted whose first round is not over (their relay has not
+  // queued its tasks yet), items emitted and not yet collected, and the leaves to emit waiting
+  // until the first is zero and the second below the number of workers.
+  std::mutex admit_mutex;
+  std::size_t first_round = 0;
+  std::size_t in_flight = 0;
+  std::size_t parked = 0;
+  const auto workers = static_cast<std::size_t>(config.workers);
+  auto may_admit = [&] { return first_round == 0 && in_flight < workers; };  // under the lock
+  auto admission_after = [&](bool first_round_ended, bool collected) {
+    std::size_t release = 0;
+    {
+      std::lock_guard<std::mutex> lock(admit_mutex);
+      first_round -= first_round_ended ? 1 : 0;
+      in_flight -= collected ? 1 : 0;
+      if (may_admit()) std::swap(release, parked);
+    }
+    // Back into the queue behind the tasks queued already: taken when a worker has no older work
+    // left. Each is checked again (the first may start a new first round).
+    for (; release > 0; --release) pending.try_put(kAdmitMsg);
+  };
+  auto first_round_over = [&] { admission_after(true, false); };
+
+  // Collection, in emission order, by the thread that completes the next item: no collector task
+  // waits for a free thread behind the next item's tasks. The lock orders consecutive
+  // collections (for ThreadSanitizer too); one thread collects at a time, outside it.
+  std::mutex collect_mutex;
+  std::size_t next_collect = 0;
+  bool collecting = false;
+  auto complete = [&](std::size_t seq) {
+    std::unique_lock<std::mutex> lock(collect_mutex);
+    slot_of(seq).completed = true;
+    while (!collecting && slot_of(next_collect).completed &&
+           slot_of(next_collect).seq == next_collect) {
+      Slot& slot = slot_of(next_collect);
+      slot.completed = false;
+      collecting = true;
+      lock.unlock();
+      (void)slot.published.load(std::memory_order_acquire);  // items without tasks
+      (void)slot.remaining.load(std::memory_order_acquire);  // every task's writes
+      (void)slot.relayed.load(std::memory_order_acquire);    // items without relay tasks
+      try {
+        cb.collect(*slot.item);
+      } catch (...) {
+        lock.lock();
+        collecting = false;  // the run stops; nothing is collected after this
+        throw;
+      }
+      slot.item.reset();
+      slot.tasks.clear();  // frees what the tasks captured
+      slot.free.store(true, std::memory_order_release);
+      lock.lock();
+      ++next_collect;
+      collecting = false;
+      lock.unlock();
+      admission_after(false, true);
+      give_back_token();
+      lock.lock();
+    }
+  };
+
+  using EmitNode = flow::multifunction_node<TaskMsg, std::tuple<TaskMsg, std::size_t>>;
+  EmitNode emit(graph, flow::serial, [&](const TaskMsg&, EmitNode::output_ports_type& ports) {
     HandoffScope scope;
+    // Just in time, the farm counted the item's first round when it gave leave to emit (so that
+    // two leaves cannot both pass before either item exists); otherwise it starts here.
+    const bool just_in_time = static_cast<bool>(config.admit_just_in_time);
+    if (!just_in_time) {
+      std::lock_guard<std::mutex> lock(admit_mutex);
+      ++first_round;
+      ++in_flight;
+    }
     if (ended.load(std::memory_order_acquire)) {
+      admission_after(true, true);
       give_back_token();
       return;
     }
@@ -119,6 +208,7 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
       std::unique_ptr<FarmItem> item = cb.emit();
       if (!item) {
         ended.store(true, std::memory_order_release);
+        admission_after(true, true);
         give_back_token();
         return;
       }
@@ -136,32 +226,46 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
       slot.published.store(seq + 1, std::memory_order_release);
     }
     if (n == 0) {
-      std::get<1>(ports).try_put(seq);
+      if (cb.relay) {
+        std::get<1>(ports).try_put(seq);
+      } else {
+        first_round_over();
+        complete(seq);
+      }
       return;
     }
     for (std::size_t i = 0; i < n; ++i) std::get<0>(ports).try_put(TaskMsg{seq, i});
   });
 
-  // Port 0: the item's first tasks are done (to the relay, or to the collector without one);
-  // port 1: its relay tasks are done (to the collector).
-  // A worker that comes free takes the oldest item's task first: a frame's labelling (the relay's
-  // tasks) does not wait behind the next frame's stereo and flow tasks that were queued before it,
-  // so the frames in flight finish as they arrived instead of all finishing late. The farm
-  // rejects what it cannot run at once, and the queue in front of it hands over by priority.
-  struct NewerIsLess {
-    bool operator()(const TaskMsg& a, const TaskMsg& b) const { return a.seq > b.seq; }
-  };
-  flow::priority_queue_node<TaskMsg, NewerIsLess> pending(graph);
+  // Port 0: the item's first tasks are done (to the relay); port 1: leave to emit (to the
+  // emitter). Items whose last tasks are done are collected here.
   using FarmNode =
-      flow::multifunction_node<TaskMsg, std::tuple<std::size_t, std::size_t>, flow::rejecting>;
+      flow::multifunction_node<TaskMsg, std::tuple<std::size_t, TaskMsg>, flow::rejecting>;
   FarmNode farm(graph, static_cast<std::size_t>(config.workers),
                 [&](const TaskMsg& msg, FarmNode::output_ports_type& ports) {
                   HandoffScope scope;
+                  if (msg.phase == kAdmit) {
+                    // Just in time: not while an item in flight is in its first round (its
+                    // stereo and flow can use every worker) nor while as many items as workers
+                    // are in flight; released when that changes.
+                    {
+                      std::lock_guard<std::mutex> lock(admit_mutex);
+                      if (!may_admit() && config.admit_just_in_time()) {
+                        ++parked;
+                        return;
+                      }
+                      ++first_round;  // the item about to be emitted
+                      ++in_flight;
+                    }
+                    std::get<1>(ports).try_put(msg);
+                    return;
+                  }
                   Slot& slot = slot_of(msg.seq);
                   // Only the emitter writes `published` (the relay `relayed`), so tasks of one
                   // item are not ordered with each other (for TSan either): they may run at once.
                   (void)slot.published.load(std::memory_order_acquire);
-                  if (msg.phase == 1) (void)slot.relayed.load(std::memory_order_acquire);
+                  if (msg.phase == kRelayTasks)
+                    (void)slot.relayed.load(std::memory_order_acquire);
                   // Isolated so that a worker waiting in a nested parallel_for (tiles, OpenCV)
                   // only helps with its own task instead of picking up another item's task,
                   // which would delay this item behind an unrelated one.
@@ -169,18 +273,18 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
                   if (slot.remaining.fetch_sub(1, std::memory_order_release) == 1) {
                     // The last task sees every task's writes before passing the item on.
                     (void)slot.remaining.load(std::memory_order_acquire);
-                    if (msg.phase == 0) {
+                    if (msg.phase == kFirstTasks && cb.relay) {
                       std::get<0>(ports).try_put(msg.seq);
                     } else {
-                      std::get<1>(ports).try_put(msg.seq);
+                      if (msg.phase == kFirstTasks) first_round_over();
+                      complete(msg.seq);
                     }
                   }
                 });
 
-  flow::sequencer_node<std::size_t> sequencer(graph, [](std::size_t seq) { return seq; });
   flow::sequencer_node<std::size_t> relay_sequencer(graph, [](std::size_t seq) { return seq; });
 
-  using RelayNode = flow::multifunction_node<std::size_t, std::tuple<TaskMsg, std::size_t>>;
+  using RelayNode = flow::multifunction_node<std::size_t, std::tuple<TaskMsg>>;
   RelayNode relay(graph, flow::serial, [&](std::size_t seq, RelayNode::output_ports_type& ports) {
     HandoffScope scope;
     Slot& slot = slot_of(seq);
@@ -194,33 +298,18 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
       slot.remaining.store(n, std::memory_order_relaxed);
       slot.relayed.store(seq + 1, std::memory_order_release);
     }
-    if (n == 0) {
-      std::get<1>(ports).try_put(seq);
-      return;
-    }
-    for (std::size_t i = 0; i < n; ++i) std::get<0>(ports).try_put(TaskMsg{seq, i, 1});
+    for (std::size_t i = 0; i < n; ++i) std::get<0>(ports).try_put(TaskMsg{seq, i, kRelayTasks});
+    first_round_over();
+    if (n == 0) complete(seq);
   });
 
-  flow::function_node<std::size_t, flow::continue_msg> collect(
-      graph, flow::serial, [&](std::size_t seq) {
-        HandoffScope scope;
-        Slot& slot = slot_of(seq);
-        (void)slot.published.load(std::memory_order_acquire);  // items without tasks
-        (void)slot.remaining.load(std::memory_order_acquire);  // every task's writes
-        (void)slot.relayed.load(std::memory_order_acquire);    // items without relay tasks
-        {
-          std::lock_guard<std::mutex> lock(collect_mutex);
-          cb.collect(*slot.item);
-          slot.item.reset();
-          slot.tasks.clear();  // frees what the tasks captured
-        }
-        slot.free.store(true, std::memory_order_release);
-        give_back_token();
-        return flow::continue_msg();
-      });
-
   flow::make_edge(ticks, limiter);
-  flow::make_edge(limiter, emit);
+  if (config.admit_just_in_time) {
+    flow::make_edge(limiter, pending);
+    flow::make_edge(flow::output_port<1>(farm), emit);
+  } else {
+    flow::make_edge(limiter, emit);
+  }
   flow::make_edge(flow::output_port<0>(emit), pending);
   flow::make_edge(pending, farm);
   if (cb.relay) {
@@ -229,13 +318,7 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
     flow::make_edge(flow::output_port<0>(farm), relay_sequencer);
     flow::make_edge(relay_sequencer, relay);
     flow::make_edge(flow::output_port<0>(relay), pending);
-    flow::make_edge(flow::output_port<1>(relay), sequencer);
-    flow::make_edge(flow::output_port<1>(farm), sequencer);
-  } else {
-    flow::make_edge(flow::output_port<1>(emit), sequencer);
-    flow::make_edge(flow::output_port<0>(farm), sequencer);
   }
-  flow::make_edge(sequencer, collect);
 
   handoff_start();
   ticks.activate();

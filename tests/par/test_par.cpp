@@ -349,6 +349,79 @@ TEST_P(FarmTest, RelayRunsInOrderAndItsTasksFinishBeforeCollection) {
   EXPECT_EQ(running_sum, sum);
 }
 
+/// Runs a relay farm whose first tasks take `first_us` and counts the emitter calls made while an
+/// earlier item's first round was not over (emitted, its relay not yet called). `most_in_flight`:
+/// the most items emitted and not collected that an emitter call found.
+int emits_during_first_rounds(FarmConfig config, int items, int first_us,
+                              int* most_in_flight = nullptr) {
+  std::mutex mutex;
+  int open = 0, overlapping = 0, next = 0, in_flight = 0, most = 0;
+  std::vector<int> order;
+  run_ordered_farm_relay(
+      config,
+      [&]() -> std::optional<Relayed> {
+        if (next == items) return std::nullopt;
+        const std::lock_guard<std::mutex> lock(mutex);
+        overlapping += open > 0;
+        ++open;
+        most = std::max(most, in_flight++);
+        Relayed r;
+        r.index = next++;
+        return r;
+      },
+      [&](Relayed& r) -> TaskList {
+        if (r.index % 7 == 6) return {};  // no first task
+        return {[&r, first_us] {
+                  pause_us(first_us);
+                  r.first = r.index;
+                },
+                [first_us] { pause_us(first_us / 2); }};
+      },
+      [&](Relayed& r) -> TaskList {
+        {
+          const std::lock_guard<std::mutex> lock(mutex);
+          --open;
+        }
+        if (r.index % 5 == 4) return {};  // no relay task
+        return {[&r] { r.history_sum = r.first; }, [] { pause_us(200); }};
+      },
+      [&](Relayed&& r) {
+        {
+          const std::lock_guard<std::mutex> lock(mutex);
+          --in_flight;
+        }
+        order.push_back(r.index);
+        if (r.index % 7 != 6 && r.index % 5 != 4) EXPECT_EQ(r.history_sum, r.index);
+      });
+  std::vector<int> expected(static_cast<std::size_t>(items));
+  std::iota(expected.begin(), expected.end(), 0);
+  EXPECT_EQ(order, expected);
+  if (most_in_flight) *most_in_flight = most;
+  return overlapping;
+}
+
+TEST_P(FarmTest, JustInTimeAdmissionWaitsForTheFirstRoundsInFlight) {
+  FarmConfig config = this->config();
+  config.admit_just_in_time = [] { return true; };
+  int most_in_flight = 0;
+  EXPECT_EQ(emits_during_first_rounds(config, 40, 300 + jitter_us(3), &most_in_flight), 0);
+  // Fewer than W items in flight when the next is emitted, whatever the tokens allow.
+  EXPECT_LT(most_in_flight, std::max(1, GetParam().workers));
+}
+
+TEST(FarmAdmissionTest, EagerAdmissionEmitsDuringFirstRounds) {
+  // Two tokens: without just-in-time admission (or while it answers no), the second item is
+  // emitted as soon as the first is, long before the first's 20 ms first round is over.
+  FarmConfig config{Backend::kTbb, 2, 2, 2};
+  int most_in_flight = 0;
+  EXPECT_GT(emits_during_first_rounds(config, 6, 20000, &most_in_flight), 0);
+  EXPECT_EQ(most_in_flight, 1);
+  config.admit_just_in_time = [] { return false; };
+  EXPECT_GT(emits_during_first_rounds(config, 6, 20000), 0);
+  config.admit_just_in_time = [] { return true; };
+  EXPECT_EQ(emits_during_first_rounds(config, 6, 20000), 0);
+}
+
 TEST_P(FarmTest, RelayTaskExceptionPropagates) {
   int next = 0;
   int collected = 0;

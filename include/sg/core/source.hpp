@@ -33,6 +33,9 @@ class FrameSource {
   virtual const Camera& camera() const = 0;
   /// Number of frames when known in advance, else -1.
   virtual int size() const { return -1; }
+  /// True for a live camera, which captures whether or not its frames are taken (a file can be
+  /// read when the pipeline is ready).
+  virtual bool live() const { return false; }
 };
 
 }  // namespace sg::core

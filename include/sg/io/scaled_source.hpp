@@ -40,6 +40,7 @@ class ScaledSource : public core::FrameSource {
   std::optional<core::PendingFrame> next_pending() override;
   const core::Camera& camera() const override { return camera_; }
   int size() const override { return inner_->size(); }
+  bool live() const override { return inner_->live(); }
   /// The source being scaled.
   core::FrameSource& inner() { return *inner_; }
 

@@ -100,6 +100,7 @@ class CaptureSource : public DeferredSource {
   std::optional<core::PendingFrame> next_pending() override;
   const core::Camera& camera() const override { return camera_; }
   int size() const override { return frame_count_; }
+  bool live() const override { return live_; }
 
  private:
   struct Capture {

@@ -38,6 +38,15 @@ struct FarmConfig {
   int workers = 1;  ///< W >= 1: most farm tasks running at once (FastFlow's farm width)
   int tokens = 4;   ///< >= 1: most items emitted and not yet collected (items in flight)
   int threads = 0;  ///< >= 0: size of the task arena the farm runs in; 0 = current arena
+  /// While this returns true, the next item is admitted just in time: a free token alone is not
+  /// enough, every item in flight must also have finished its first round (its relay has queued
+  /// its second tasks), fewer than `workers` items may be in flight, and no worker may have an
+  /// older task to take. For a live source that is
+  /// falling behind: the item is then taken from it as late as it can start, so it is fresher,
+  /// instead of waiting in the queue while the older items' first rounds take every worker.
+  /// Null (the default): admitted as soon as a token frees. Called from the farm's threads,
+  /// never concurrently with itself. Ignored by kSequential.
+  std::function<bool()> admit_just_in_time;
 };
 
 /// Every violation as "par.<field>=<value>: <rule>"; empty when valid.

@@ -14,6 +14,7 @@ class DroppingSource : public core::FrameSource {
   std::optional<core::StereoFrame> next() override;
   const core::Camera& camera() const override { return inner_.camera(); }
   int size() const override { return -1; }
+  bool live() const override { return inner_.live(); }
   int dropped() const { return dropped_; }
 
  private:
