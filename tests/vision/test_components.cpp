@@ -63,7 +63,8 @@ void expect_same_as_opencv(const cv::Mat& mask, const std::string& what) {
       ASSERT_EQ(ours == 0, mask.at<std::uint8_t>(y, x) == 0) << what << " at " << x << "," << y;
       if (ours == 0) continue;
       if (!ours_to_cv.count(ours)) {
-        ASSERT_EQ(ours, next_new++) << what << ": not numbered in raster order at " << x << "," << y;
+        ASSERT_EQ(ours, next_new++)
+            << what << ": not numbered in raster order at " << x << "," << y;
         ours_to_cv[ours] = theirs;
       }
       if (!cv_to_ours.count(theirs)) cv_to_ours[theirs] = ours;
