@@ -3,27 +3,11 @@
 #include <cmath>
 #include <sstream>
 
+#include "sg/core/checker.hpp"
 #include "sg/core/error.hpp"
 
 namespace sg::core {
 namespace {
-
-/// Collects "<section>.<field>=<value>: <rule>" lines.
-class Checker {
- public:
-  Checker(std::vector<std::string>& out, const char* section) : out_(out), section_(section) {}
-  template <typename T>
-  void require(bool ok, const char* field, const T& value, const char* rule) {
-    if (ok) return;
-    std::ostringstream s;
-    s << section_ << "." << field << "=" << value << ": " << rule;
-    out_.push_back(s.str());
-  }
-
- private:
-  std::vector<std::string>& out_;
-  const char* section_;
-};
 
 bool finite_positive(double v) { return std::isfinite(v) && v > 0; }
 

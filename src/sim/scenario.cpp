@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "sg/core/checker.hpp"
 #include "sg/core/error.hpp"
 #include "sg/core/platform.hpp"
 #include "sg/core/yaml_text.hpp"
@@ -39,21 +40,7 @@ std::string to_text(const cv::Vec3d& v) {
   return out;
 }
 
-/// Collects "<field>=<value>: <rule>" lines.
-class Checker {
- public:
-  explicit Checker(std::vector<std::string>& out) : out_(out) {}
-  template <typename T>
-  void require(bool ok, const std::string& field, const T& value, const char* rule) {
-    if (ok) return;
-    std::ostringstream s;
-    s << field << "=" << value << ": " << rule;
-    out_.push_back(s.str());
-  }
-
- private:
-  std::vector<std::string>& out_;
-};
+using core::Checker;
 
 // ---- YAML reading -------------------------------------------------------------------------------
 
