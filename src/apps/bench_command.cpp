@@ -31,7 +31,7 @@ struct BenchArgs {
 };
 
 void print_row(const pipeline::BenchRow& r) {
-  std::cout << std::left << std::setw(9) << r.kind << std::setw(12) << r.mode << std::right
+  std::cout << std::left << std::setw(10) << r.kind << std::setw(12) << r.mode << std::right
             << std::setw(5) << r.resolution.width << "x" << std::left << std::setw(5)
             << r.resolution.height << std::right << std::setw(3) << r.workers << std::setw(4)
             << r.tiles << std::setw(4) << r.tokens << std::fixed << std::setprecision(1)
@@ -105,7 +105,7 @@ void bench_main(const BenchArgs& a) {
   std::cout << "stereoguard bench: " << what << ", " << a.frames
             << " frames per configuration held in memory; pipeline rows: matcher " << a.matcher
             << " (baselines: bm)\n"
-            << "kind     mode          resolution  W   T tok  pace/s     fps  vs-mt   vs-1t"
+            << "kind      mode          resolution  W   T tok  pace/s     fps  vs-mt   vs-1t"
                "     p50     p99   drop  same\n"
             << "(vs-mt: speedup against the plain loop with OpenCV's threads, the default a user "
                "gets; vs-1t: against the same loop on one thread)\n";

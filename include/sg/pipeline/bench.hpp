@@ -26,8 +26,8 @@ struct BenchConfig {
   int threads = 0;           ///< task-arena size (0 = all cores)
   int tokens = 0;            ///< frames in flight of the pipeline rows (0 = automatic: RunOptions)
   std::string scenario = "head-on";
-  /// Also run the best configuration of each mode (first resolution) paced at these fractions of
-  /// its measured capacity (empty = none).
+  /// Also run the best configuration of each mode (first resolution, best_for_pacing) paced at
+  /// these fractions of its measured capacity (empty = none).
   std::vector<double> pace_fractions = {0.8, 1.5};
   /// When set, the frames come from this input instead of the scenario: read once into memory (up
   /// to `frames`, played forwards then backwards when shorter), at the input's own resolution and
@@ -61,6 +61,12 @@ std::string bench_csv_header();
 /// "yes" / "no", or "n/a" for a paced run that dropped frames.
 std::string same_detections_text(const BenchRow& row);
 std::string to_csv(const BenchRow& row);
+
+/// The configuration a user would pace a camera with, among `pipeline` rows: the lowest p99
+/// latency among those within 5 % of the highest throughput (run-to-run noise), so that more
+/// workers than cores, which add latency but no throughput, are not chosen by chance. Returns
+/// the row's index, or rows.size() when there is none.
+std::size_t best_for_pacing(const std::vector<BenchRow>& rows);
 
 /// Runs the sweep; `on_row` sees each row as soon as it is measured.
 std::vector<BenchRow> run_bench(const BenchConfig& config,
