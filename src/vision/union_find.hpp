@@ -1,6 +1,6 @@
 #pragma once
-// The union-find of the run-based labellings (segment_motion.cpp, components.cpp). Internal
-// header.
+// The union-find of the run-based labellings (segment_motion.cpp, components.cpp) and of the
+// relative-size feature clusters (relative_size.cpp). Internal header.
 #include <algorithm>
 #include <vector>
 

@@ -1,0 +1,116 @@
+#include "sg/vision/longseq.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include "sg/core/checker.hpp"
+#include "sg/core/error.hpp"
+
+namespace sg::vision {
+namespace {
+
+/// The disparity of every pixel of one row of `ref` matched against `other`, whose pixel x + sign
+/// * d corresponds to ref's pixel x (sign -1: ref is the left image). `bad` and `cost` are scratch
+/// of num_disparities entries; out[x] = -1 where unmatched.
+void match_row(const std::uint8_t* ref, const std::uint8_t* other, int width, int sign,
+               const LongSeqParams& p, std::vector<std::uint8_t>& bad, std::vector<int>& cost,
+               float* out) {
+  const int r = p.window_px / 2, n = p.num_disparities;
+  // Costs as window sums of absolute differences: the thresholds times the window's pixels.
+  const double window = p.window_px;
+  const int cost_max = static_cast<int>(std::floor(p.cost_max * window));
+  const int best_max = static_cast<int>(std::floor(p.best_max * window));
+  for (int x = 0; x < width; ++x) {
+    out[x] = -1.0f;
+    // Every disparity's window must lie inside both images.
+    const int lo = sign < 0 ? x - (n - 1) - r : x - r;
+    const int hi = sign < 0 ? x + r : x + (n - 1) + r;
+    if (lo < 0 || hi >= width) continue;
+    int best = 255 * p.window_px;
+    for (int d = 0; d < n; ++d) {
+      const std::uint8_t* o = other + x + sign * d;
+      int c = 0;
+      for (int k = -r; k <= r; ++k) c += std::abs(int{ref[x + k]} - int{o[k]});
+      cost[static_cast<size_t>(d)] = c;
+      best = std::min(best, c);
+    }
+    if (best > best_max) continue;
+    for (int d = 0; d < n; ++d)
+      bad[static_cast<size_t>(d)] = cost[static_cast<size_t>(d)] > cost_max ? 1 : 0;
+    out[x] = static_cast<float>(longest_good_run(bad.data(), n));
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> validate(const LongSeqParams& p) {
+  std::vector<std::string> out;
+  core::Checker c(out, "longseq");
+  c.require(p.num_disparities >= 1 && p.num_disparities <= 1024, "num_disparities",
+            p.num_disparities, "must be in 1..1024");
+  c.require(p.window_px >= 1 && p.window_px % 2 == 1 && p.window_px <= 63, "window_px",
+            p.window_px, "must be odd, in 1..63");
+  c.require(std::isfinite(p.cost_max) && p.cost_max >= 0 && p.cost_max <= 255, "cost_max",
+            p.cost_max, "must be in 0..255 (grey levels)");
+  c.require(std::isfinite(p.best_max) && p.best_max >= 0 && p.best_max <= p.cost_max,
+            "best_max", p.best_max, "must be in 0..cost_max (grey levels)");
+  return out;
+}
+
+void good_run_lengths(const std::uint8_t* bad, int n, int* out) {
+  for (int d = 0; d < n;) {
+    if (bad[d]) {
+      out[d++] = 1;
+      continue;
+    }
+    int end = d;
+    while (end < n && !bad[end]) ++end;
+    std::fill(out + d, out + end, end - d);
+    d = end;
+  }
+}
+
+int longest_good_run(const std::uint8_t* bad, int n) {
+  int best_begin = -1, best_length = 0;
+  for (int d = 0; d < n;) {
+    if (bad[d]) {
+      ++d;
+      continue;
+    }
+    int end = d;
+    while (end < n && !bad[end]) ++end;
+    if (end - d > best_length) best_begin = d, best_length = end - d;
+    d = end;
+  }
+  return best_begin < 0 ? -1 : best_begin + (best_length - 1) / 2;
+}
+
+void longseq_disparity(const cv::Mat& left, const cv::Mat& right, const LongSeqParams& p,
+                       cv::Mat& disparity) {
+  core::throw_if_invalid(validate(p), "invalid parameters");
+  if (left.type() != CV_8UC1 || right.type() != CV_8UC1 || left.size() != right.size() ||
+      left.empty())
+    throw core::InputError(
+        "longseq: left and right must be non-empty 8-bit grey images of one size");
+  const int w = left.cols;
+  disparity.create(left.size(), CV_32FC1);
+  std::vector<std::uint8_t> bad(static_cast<size_t>(p.num_disparities));
+  std::vector<int> cost(static_cast<size_t>(p.num_disparities));
+  std::vector<float> from_right(p.both_ways ? static_cast<size_t>(w) : 0);
+  for (int y = 0; y < left.rows; ++y) {
+    float* out = disparity.ptr<float>(y);
+    match_row(left.ptr<std::uint8_t>(y), right.ptr<std::uint8_t>(y), w, -1, p, bad, cost, out);
+    if (!p.both_ways) continue;
+    // The right image's pixel x - d sees the left one's x: keep the smaller disparity of the two.
+    match_row(right.ptr<std::uint8_t>(y), left.ptr<std::uint8_t>(y), w, +1, p, bad, cost,
+              from_right.data());
+    for (int x = 0; x < w; ++x) {
+      if (out[x] < 0.0f) continue;
+      const float back = from_right[static_cast<size_t>(x - static_cast<int>(out[x]))];
+      out[x] = back < 0.0f ? -1.0f : std::min(out[x], back);
+    }
+  }
+}
+
+}  // namespace sg::vision
