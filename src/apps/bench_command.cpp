@@ -141,8 +141,8 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--tokens", a->tokens, "frames in flight of the pipeline rows (default 0: W + 1, or W when paced)");
   cmd->add_option("--scenario", a->scenario, "scenario rendered for the frames (default head-on)");
   cmd->add_option("--pace", a->pace,
-                  "also pace the best configuration at these fractions of its capacity "
-                  "(first resolution; default 0.8,1.5)")
+                  "also pace the best configuration (lowest p99 within 5 % of the top fps) at "
+                  "these fractions of its capacity (first resolution; default 0.8,1.5)")
       ->delimiter(',');
   add_source_options(*cmd, a->input);
   cmd->add_option("--csv", a->csv, "CSV output (default stereoguard-bench.csv)");
