@@ -134,8 +134,8 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--frames", a->frames, "frames per configuration (default 300)");
   cmd->add_option("--num-disparities", a->num_disparities, "stereo search range (default 64)");
   cmd->add_option("--matcher", a->matcher,
-                  "stereo matcher of the pipeline rows: fast (default), bm or sgbm (the baselines "
-                  "stay StereoBM)");
+                  "stereo matcher of the pipeline rows: fast (default), bm, sgbm or longseq (the "
+                  "baselines stay StereoBM)");
   cmd->add_option("--cost", a->cost, "fast matcher cost: sad (default) or census");
   cmd->add_option("--threads", a->threads, "task-arena size (default 0 = all cores)");
   cmd->add_option("--tokens", a->tokens, "frames in flight of the pipeline rows (default 0: W + 1, or W when paced)");

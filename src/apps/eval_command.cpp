@@ -286,8 +286,8 @@ void add_eval_command(CLI::App& app) {
                   "with --stereo: 8-bit GT PNG scale, disparity = value / scale (default 0 = "
                   "from the folder's datasets.xml)");
   cmd->add_option("--matchers", args->matchers,
-                  "with --stereo: bm, sgbm, fast, fast-sad, fast-census, comma-separated "
-                  "(default all but fast-sad)");
+                  "with --stereo: bm, sgbm, fast, fast-sad, fast-census, longseq, comma-separated "
+                  "(default bm,sgbm,fast,fast-census)");
   cmd->add_option("--flow-methods", args->flow_methods,
                   "with --flow: dis-ultrafast, dis-fast, dis-medium, farneback or all (default)");
   cmd->callback([args] { eval_main(*args); });

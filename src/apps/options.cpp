@@ -123,7 +123,8 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
   app.add_option("--block-size", o.block_size, "stereo block size, px (odd, 5..255)");
   app.add_option("--matcher", o.matcher,
                  "stereo matcher: fast (our SIMD block matcher, StereoBM's results; default), bm "
-                 "(OpenCV StereoBM) or sgbm (OpenCV StereoSGBM)");
+                 "(OpenCV StereoBM), sgbm (OpenCV StereoSGBM) or longseq (thesis 3.2.3: longest "
+                 "run of good matches over one row)");
   app.add_option("--cost", o.cost, "fast matcher cost: sad (default) or census");
   app.add_option("--gaps", o.gaps,
                  "frame gaps k compared by the mode's labelling, e.g. --gaps 1 (the thesis) or "

@@ -26,6 +26,7 @@ const char* to_string(Matcher m) {
     case Matcher::kBm: return "bm";
     case Matcher::kSgbm: return "sgbm";
     case Matcher::kFast: return "fast";
+    case Matcher::kLongSeq: return "longseq";
   }
   return "?";
 }
@@ -34,7 +35,8 @@ Matcher parse_matcher(const std::string& text) {
   if (text == "bm") return Matcher::kBm;
   if (text == "sgbm") return Matcher::kSgbm;
   if (text == "fast") return Matcher::kFast;
-  throw InputError("stereo.matcher=" + text + ": must be bm, sgbm or fast");
+  if (text == "longseq") return Matcher::kLongSeq;
+  throw InputError("stereo.matcher=" + text + ": must be bm, sgbm, fast or longseq");
 }
 
 const char* to_string(MatchCost c) { return c == MatchCost::kSad ? "sad" : "census"; }
@@ -60,6 +62,19 @@ std::vector<std::string> validate(const BmParams& p) {
   c.require(p.speckle_window >= 0, "speckle_window", p.speckle_window, "must be >= 0");
   c.require(p.speckle_range >= 0, "speckle_range", p.speckle_range, "must be >= 0");
   c.require(p.lr_max_diff >= -1, "lr_max_diff", p.lr_max_diff, "must be -1 (off) or >= 0");
+  if (p.matcher == Matcher::kLongSeq) {
+    c.require(p.block_size <= 63, "block_size", p.block_size,
+              "must be <= 63 with matcher longseq (its one-row window)");
+    c.require(p.min_disparity == 0, "min_disparity", p.min_disparity,
+              "must be 0 with matcher longseq");
+    c.require(std::isfinite(p.longseq_cost_max) && p.longseq_cost_max >= 0 &&
+                  p.longseq_cost_max <= 255,
+              "longseq_cost_max", p.longseq_cost_max, "must be in 0..255 (grey levels)");
+    c.require(std::isfinite(p.longseq_best_max) && p.longseq_best_max >= 0 &&
+                  p.longseq_best_max <= p.longseq_cost_max,
+              "longseq_best_max", p.longseq_best_max,
+              "must be in 0..longseq_cost_max (grey levels)");
+  }
   if (p.matcher == Matcher::kFast) {
     // The fast matcher sums block costs in 16-bit lanes: the largest block sum must fit.
     const int max_pixel_cost = p.cost == MatchCost::kSad ? 2 * p.prefilter_cap : 24;

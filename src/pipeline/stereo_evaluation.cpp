@@ -22,8 +22,8 @@ StereoMatcherEntry parse_matcher_entry(const std::string& text, const core::BmPa
     e.params.matcher = core::parse_matcher(text);
   } catch (const core::InputError&) {
     throw core::InputError("matchers=" + text +
-                           ": each must be bm, sgbm, fast, fast-sad or "
-                           "fast-census");
+                           ": each must be bm, sgbm, fast, fast-sad, "
+                           "fast-census or longseq");
   }
   return e;
 }

@@ -4,6 +4,7 @@
 
 #include "sg/core/error.hpp"
 #include "sg/vision/flow.hpp"
+#include "sg/vision/longseq.hpp"
 #include "sg/vision/stereo_bm.hpp"
 #include "sg/vision/stereo_fast.hpp"
 #include "sg/vision/stereo_sgbm.hpp"
@@ -30,6 +31,16 @@ void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& 
     case core::Matcher::kFast:
       match_fast_rows(frame.left, frame.right, params.bm, disp, rows);
       break;
+    case core::Matcher::kLongSeq: {
+      LongSeqParams p;
+      p.num_disparities = params.bm.num_disparities;
+      p.window_px = params.bm.block_size;
+      p.cost_max = params.bm.longseq_cost_max;
+      p.best_max = params.bm.longseq_best_max;
+      p.both_ways = params.bm.longseq_both_ways;
+      longseq_disparity_rows(frame.left, frame.right, p, disp, rows);
+      break;
+    }
   }
 }
 

@@ -24,6 +24,27 @@ TEST(Params, EvenBlockSizeIsRejected) {
   EXPECT_TRUE(mentions(validate(p, Camera{}), "stereo.block_size=10"));
 }
 
+TEST(Params, LongSeqMatcherRulesNameTheirFields) {
+  EXPECT_EQ(parse_matcher("longseq"), Matcher::kLongSeq);
+  EXPECT_STREQ(to_string(Matcher::kLongSeq), "longseq");
+  DetectorParams p;
+  p.bm.matcher = Matcher::kLongSeq;
+  EXPECT_TRUE(validate(p, Camera{}).empty());
+  p.bm.block_size = 65;
+  p.bm.min_disparity = 16;
+  p.bm.longseq_cost_max = 300;
+  p.bm.longseq_best_max = -1;
+  const std::vector<std::string> problems = validate(p, Camera{});
+  EXPECT_TRUE(mentions(problems, "stereo.block_size=65: must be <= 63 with matcher longseq"));
+  EXPECT_TRUE(mentions(problems, "stereo.min_disparity=16: must be 0 with matcher longseq"));
+  EXPECT_TRUE(mentions(problems, "stereo.longseq_cost_max=300"));
+  EXPECT_TRUE(mentions(problems, "stereo.longseq_best_max=-1"));
+  // The same block is fine for the block matchers.
+  p.bm.matcher = Matcher::kBm;
+  EXPECT_FALSE(mentions(validate(p, Camera{}), "matcher longseq"));
+  EXPECT_THROW(parse_matcher("long-seq"), InputError);
+}
+
 TEST(Params, NumDisparitiesMustBePositiveMultipleOf16) {
   for (int n : {0, -16, 70}) {
     DetectorParams p;

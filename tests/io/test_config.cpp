@@ -157,6 +157,14 @@ TEST(Config, StereoMatcherAndCost) {
   path = write_file(dir, "stereo: {matcher: elas}\n");
   const std::string message = input_error_of([&] { apply_config_file(path, p, s); });
   EXPECT_NE(message.find("stereo.matcher=elas"), std::string::npos) << message;
+  path = write_file(dir,
+                    "stereo: {matcher: longseq, longseq_cost_max: 9.5, longseq_best_max: 4,"
+                    " longseq_both_ways: false}\n");
+  apply_config_file(path, p, s);
+  EXPECT_EQ(p.bm.matcher, core::Matcher::kLongSeq);
+  EXPECT_DOUBLE_EQ(p.bm.longseq_cost_max, 9.5);
+  EXPECT_DOUBLE_EQ(p.bm.longseq_best_max, 4.0);
+  EXPECT_FALSE(p.bm.longseq_both_ways);
 }
 
 }  // namespace

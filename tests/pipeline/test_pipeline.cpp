@@ -3,6 +3,7 @@
 // instead of queueing them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "sg/core/error.hpp"
@@ -107,6 +108,27 @@ INSTANTIATE_TEST_SUITE_P(Modes, EveryConfiguration,
                          [](const auto& info) {
                            return info.param == core::Mode::kStereo ? "Stereo" : "StereoFlow";
                          });
+
+TEST(Pipeline, LongSeqMatcherTilesAndWorkersGiveTheSequentialDetections) {
+  // LongSeq's rows are independent: row tiles and workers change nothing, in both modes.
+  for (const core::Mode mode : {core::Mode::kStereo, core::Mode::kStereoFlow}) {
+    RunOptions reference = options_for(mode);
+    reference.params.bm.matcher = core::Matcher::kLongSeq;
+    const std::vector<std::string> expected = detections(head_on(), reference);
+    ASSERT_EQ(expected.size(), head_on().frames.size());
+    const auto fired = std::count_if(expected.begin(), expected.end(), [](const std::string& l) {
+      return l.find("\"signal\":true") != std::string::npos;
+    });
+    EXPECT_GT(fired, 0) << core::to_string(mode);  // the box comes at the camera
+    for (const auto& [w, t] : {std::pair{2, 1}, std::pair{1, 3}, std::pair{2, 2}}) {
+      RunOptions o = reference;
+      o.workers = w;
+      o.tiles = t;
+      EXPECT_EQ(detections(head_on(), o), expected)
+          << core::to_string(mode) << " W " << w << " T " << t;
+    }
+  }
+}
 
 TEST_P(EveryConfiguration, PlainLoopGivesThePipelineDetections) {
   // The baseline of bench and bench_process.sh does the same work: StereoBM, DIS ultrafast and

@@ -15,11 +15,12 @@ const char* to_string(Mode m);
 /// Parses "stereo" / "stereo-flow"; throws InputError otherwise.
 Mode parse_mode(const std::string& text);
 
-/// Stereo matcher (DESIGN 2.1): OpenCV StereoBM, OpenCV StereoSGBM, or our own SIMD matcher.
-enum class Matcher { kBm, kSgbm, kFast };
-/// "bm" / "sgbm" / "fast".
+/// Stereo matcher (DESIGN 2.1): OpenCV StereoBM, OpenCV StereoSGBM, our own SIMD matcher, or
+/// LongSeq (thesis 3.2.3, vision/longseq.hpp: the longest run of good matches over one row).
+enum class Matcher { kBm, kSgbm, kFast, kLongSeq };
+/// "bm" / "sgbm" / "fast" / "longseq".
 const char* to_string(Matcher m);
-/// Parses "bm" / "sgbm" / "fast"; throws InputError otherwise.
+/// Parses "bm" / "sgbm" / "fast" / "longseq"; throws InputError otherwise.
 Matcher parse_matcher(const std::string& text);
 /// Matching cost of the `fast` matcher: SAD on the x-Sobel prefiltered image (as StereoBM), or
 /// the Hamming distance of 5x5 census signatures (robust to exposure differences).
@@ -32,7 +33,7 @@ MatchCost parse_match_cost(const std::string& text);
 /// Stereo matching settings (DESIGN 2.1); the names follow OpenCV StereoBM, whose meaning the
 /// `fast` matcher keeps. `sgbm` uses the range, block size, uniqueness, speckle and lr fields.
 struct BmParams {
-  /// fast (default: StereoBM's results at several times its speed), bm or sgbm
+  /// fast (default: StereoBM's results at several times its speed), bm, sgbm or longseq
   Matcher matcher = Matcher::kFast;
   MatchCost cost = MatchCost::kSad; ///< cost of the fast matcher (bm/sgbm ignore it)
   int min_disparity = 0;        ///< px
@@ -44,6 +45,11 @@ struct BmParams {
   int speckle_window = 100;     ///< px, 0 disables the speckle filter
   int speckle_range = 2;        ///< px (scaled by 16 internally), >= 0
   int lr_max_diff = -1;         ///< px, left-right check tolerance; -1 disables
+  // LongSeq (matcher longseq): its window is one row of block_size pixels (<= 63), its disparities
+  // 0 .. num_disparities - 1 (min_disparity 0).
+  double longseq_cost_max = 6.0;  ///< a good match: mean absolute difference <= this, grey levels
+  double longseq_best_max = 3.0;  ///< a pixel whose best match costs more is unmatched, grey levels
+  bool longseq_both_ways = true;  ///< also match right to left, keep the smaller disparity
 };
 
 /// The space the platform occupies, in camera coordinates (DESIGN 3.2). Defaults: a small robot.

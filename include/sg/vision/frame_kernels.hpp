@@ -12,7 +12,7 @@ namespace sg::vision {
 /// Throws core::InputError unless left/right are non-empty CV_8UC1 images of the same size.
 void check_frame(const core::StereoFrame& frame);
 
-/// SM on output rows `rows` with params.bm.matcher (bm, sgbm or fast): raw matching without the
+/// SM on output rows `rows` with params.bm.matcher (bm, sgbm, fast or longseq): raw matching without the
 /// speckle filter (sgbm is not tileable: each tile matches the whole image, see stereo_sgbm.hpp). disp must be allocated
 /// as CV_32F of the frame size before tiles run (allocate_maps). Tiles stitched are bit-identical
 /// to one call over all rows.

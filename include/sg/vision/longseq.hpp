@@ -40,9 +40,21 @@ void good_run_lengths(const std::uint8_t* bad, int n, int* out);
 int longest_good_run(const std::uint8_t* bad, int n);
 
 /// LongSeq disparity of an 8-bit grey rectified pair of one size: CV_32F, px (whole pixels), -1
-/// where unmatched or where the search range leaves the image. Throws core::InputError on a
-/// type or size mismatch or invalid parameters.
+/// where unmatched or where the search range leaves the image. Each disparity's costs are running
+/// window sums along the row. Throws core::InputError on a type or size mismatch or invalid
+/// parameters.
 void longseq_disparity(const cv::Mat& left, const cv::Mat& right, const LongSeqParams& p,
                        cv::Mat& disparity);
+
+/// The rows `rows` of longseq_disparity (cv::Range::all(): every row); `disparity` is allocated
+/// when it is not a CV_32F map of the images' size, its other rows are left as they are. Rows are
+/// independent, so row tiles equal the whole image.
+void longseq_disparity_rows(const cv::Mat& left, const cv::Mat& right, const LongSeqParams& p,
+                            cv::Mat& disparity, cv::Range rows);
+
+/// longseq_disparity with every cost summed pixel by pixel: the reference the running sums are
+/// tested against (equal integers, so equal results).
+void longseq_disparity_reference(const cv::Mat& left, const cv::Mat& right,
+                                 const LongSeqParams& p, cv::Mat& disparity);
 
 }  // namespace sg::vision
