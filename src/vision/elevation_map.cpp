@@ -110,12 +110,13 @@ RoadModel fit_road(const cv::Mat& disp, const core::Camera& cam, const Elevation
   if (best.inliers < p.min_inliers) return RoadModel{};
   std::vector<cv::Point3d> in;
   inliers_of(best, &in);
+  // The least-squares refit of the inliers, unless it is degenerate or keeps too few of them.
+  best.found = true;
   RoadModel refit;
-  if (!solve_road(in, refit)) return best.inliers >= p.min_inliers ? best : RoadModel{};
+  if (!solve_road(in, refit)) return best;
   refit.inliers = inliers_of(refit, nullptr);
-  refit.found = refit.inliers >= p.min_inliers;
-  if (!refit.found) return RoadModel{};
-  return refit;
+  refit.found = true;
+  return refit.inliers >= p.min_inliers ? refit : best;
 }
 
 bool ElevationMap::locate(double X, double Z, int& row, int& col) const {
