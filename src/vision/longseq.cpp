@@ -43,45 +43,60 @@ void match_row_reference(const std::uint8_t* ref, const std::uint8_t* other, int
   }
 }
 
-/// Scratch of the fast row matcher: the window sums of every disparity over the row.
+/// Scratch of the fast row matcher.
 struct RowScratch {
-  std::vector<int> sums;  ///< [x * num_disparities + d]: a pixel's costs side by side
-  std::vector<int> diff;  ///< one disparity's absolute differences, with a leading 0 prefix
+  std::vector<std::int16_t> diff;  ///< [k * num_disparities + d] = |ref(k) - other(k + sign d)|
+  std::vector<std::int16_t> cost;  ///< one pixel's window sums, d = 0 .. num_disparities - 1
   std::vector<std::uint8_t> bad;
 };
 
-/// match_row_reference with each disparity's costs as running window sums along the row: O(width)
-/// per disparity instead of O(width * window). The sums are the same integers, so the result is
-/// identical.
+/// match_row_reference with each pixel's costs as a running window sum along the row: the costs
+/// of x are those of x - 1 plus the differences entering the window less those leaving it, all
+/// disparities side by side (16-bit: a sum is at most 255 * 63). The sums are the same integers,
+/// so the result is identical.
 void match_row(const std::uint8_t* ref, const std::uint8_t* other, int width, int sign,
                const LongSeqParams& p, RowScratch& s, float* out) {
   const int r = p.window_px / 2, n = p.num_disparities;
   const int cost_max = static_cast<int>(std::floor(p.cost_max * p.window_px));
   const int best_max = static_cast<int>(std::floor(p.best_max * p.window_px));
-  s.sums.assign(static_cast<size_t>(n) * static_cast<size_t>(width), 0);
-  s.diff.assign(static_cast<size_t>(width) + 1, 0);
-  s.bad.resize(static_cast<size_t>(n));
+  const auto un = static_cast<size_t>(n);
+  s.diff.assign(un * static_cast<size_t>(width), 0);
+  s.cost.assign(un, 0);
+  s.bad.resize(un);
+  for (int k = 0; k < width; ++k) {
+    std::int16_t* dk = &s.diff[static_cast<size_t>(k) * un];
+    const int v = ref[k];
+    // The disparities whose pixel of `other` exists (the rest stay 0, outside every window used).
+    if (sign < 0) {
+      const std::uint8_t* o = other + k;
+      for (int d = 0, end = std::min(n, k + 1); d < end; ++d)
+        dk[d] = static_cast<std::int16_t>(std::abs(v - int{o[-d]}));
+    } else {
+      const std::uint8_t* o = other + k;
+      for (int d = 0, end = std::min(n, width - k); d < end; ++d)
+        dk[d] = static_cast<std::int16_t>(std::abs(v - int{o[d]}));
+    }
+  }
   // Pixels whose every window lies inside both images: x - (n - 1) - r >= 0 and x + r < width
   // (ref left, sign -1), or x - r >= 0 and x + (n - 1) + r < width (sign +1).
   const int x_lo = sign < 0 ? n - 1 + r : r;
   const int x_hi = sign < 0 ? width - 1 - r : width - n - r;  // inclusive
-  for (int d = 0; d < n; ++d) {
-    // prefix[x + 1] = sum of |ref(k) - other(k + sign d)| for k <= x, where other's pixel exists.
-    int* prefix = s.diff.data();
-    for (int x = 0; x < width; ++x) {
-      const int o = x + sign * d;
-      prefix[x + 1] = prefix[x] + (o >= 0 && o < width ? std::abs(int{ref[x]} - int{other[o]}) : 0);
-    }
-    for (int x = x_lo; x <= x_hi; ++x)
-      s.sums[static_cast<size_t>(x) * static_cast<size_t>(n) + static_cast<size_t>(d)] =
-          prefix[x + r + 1] - prefix[x - r];
-  }
+  std::int16_t* cost = s.cost.data();
   for (int x = 0; x < width; ++x) {
     out[x] = -1.0f;
     if (x < x_lo || x > x_hi) continue;
-    const int* cost = &s.sums[static_cast<size_t>(x) * static_cast<size_t>(n)];
-    int best = 255 * p.window_px;
-    for (int d = 0; d < n; ++d) best = std::min(best, cost[d]);
+    if (x == x_lo) {
+      for (int k = x - r; k <= x + r; ++k) {
+        const std::int16_t* dk = &s.diff[static_cast<size_t>(k) * un];
+        for (int d = 0; d < n; ++d) cost[d] = static_cast<std::int16_t>(cost[d] + dk[d]);
+      }
+    } else {
+      const std::int16_t* in = &s.diff[static_cast<size_t>(x + r) * un];
+      const std::int16_t* gone = &s.diff[static_cast<size_t>(x - r - 1) * un];
+      for (int d = 0; d < n; ++d) cost[d] = static_cast<std::int16_t>(cost[d] + in[d] - gone[d]);
+    }
+    int best = cost[0];
+    for (int d = 1; d < n; ++d) best = std::min(best, int{cost[d]});
     if (best > best_max) continue;
     for (int d = 0; d < n; ++d) s.bad[static_cast<size_t>(d)] = cost[d] > cost_max ? 1 : 0;
     out[x] = static_cast<float>(longest_good_run(s.bad.data(), n));
@@ -140,18 +155,16 @@ void good_run_lengths(const std::uint8_t* bad, int n, int* out) {
 }
 
 int longest_good_run(const std::uint8_t* bad, int n) {
-  int best_begin = -1, best_length = 0;
-  for (int d = 0; d < n;) {
-    if (bad[d]) {
-      ++d;
-      continue;
-    }
-    int end = d;
-    while (end < n && !bad[end]) ++end;
-    if (end - d > best_length) best_begin = d, best_length = end - d;
-    d = end;
+  // The run ending at d grows by one on a good entry and restarts on a bad one; the first
+  // strictly longest run wins.
+  int length = 0, best_length = 0, best_end = -1;
+  for (int d = 0; d < n; ++d) {
+    length = bad[d] ? 0 : length + 1;
+    const bool longer = length > best_length;
+    best_length = longer ? length : best_length;
+    best_end = longer ? d : best_end;
   }
-  return best_begin < 0 ? -1 : best_begin + (best_length - 1) / 2;
+  return best_end < 0 ? -1 : best_end - best_length + 1 + (best_length - 1) / 2;
 }
 
 void longseq_disparity_rows(const cv::Mat& left, const cv::Mat& right, const LongSeqParams& p,

@@ -126,7 +126,8 @@ double segmentation_energy(const cv::Mat& image, const cv::Mat& xi, const SceneF
                            const cv::Mat& moving) {
   check_segmentation_inputs(image, xi, p);
   if (moving.type() != CV_8UC1 || moving.size() != image.size())
-    throw core::InputError("scene-flow segmentation: the labelling must be CV_8U of the image's size");
+    throw core::InputError(
+        "scene-flow segmentation: the labelling must be CV_8U of the image's size");
   double e = 0.0;
   for (int y = 0; y < image.rows; ++y) {
     for (int x = 0; x < image.cols; ++x) {

@@ -29,7 +29,8 @@ cv::Mat render(const core::Camera& cam, const RoadModel& road, double box_z) {
       } else {
         const double disc = B * B - 4.0 * A * C;
         if (disc >= 0.0) {
-          const double r1 = (-B - std::sqrt(disc)) / (2.0 * A), r2 = (-B + std::sqrt(disc)) / (2.0 * A);
+          const double r1 = (-B - std::sqrt(disc)) / (2.0 * A);
+          const double r2 = (-B + std::sqrt(disc)) / (2.0 * A);
           const double lo = std::min(r1, r2), hi = std::max(r1, r2);
           Z = lo > 0.0 ? lo : hi;
         }

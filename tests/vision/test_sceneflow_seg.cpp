@@ -15,7 +15,8 @@ double brute_force_minimum(const cv::Mat& image, const cv::Mat& xi, const SceneF
   double best = std::numeric_limits<double>::infinity();
   cv::Mat labels(image.size(), CV_8UC1);
   for (int bits = 0; bits < (1 << n); ++bits) {
-    for (int i = 0; i < n; ++i) labels.at<std::uint8_t>(i / image.cols, i % image.cols) = (bits >> i) & 1;
+    for (int i = 0; i < n; ++i)
+      labels.at<std::uint8_t>(i / image.cols, i % image.cols) = (bits >> i) & 1;
     best = std::min(best, segmentation_energy(image, xi, p, labels));
   }
   return best;
@@ -61,7 +62,8 @@ TEST(SceneFlowSeg, SmoothsALikelyBlobAndIgnoresIsolatedNoise) {
 TEST(SceneFlowSeg, MotionLikelihoodIsSmallForStaticAndLargeForMoving) {
   core::Camera cam;
   // A wall at 5 m, static: same disparity, zero flow; then approaching by 0.5 m.
-  const float d5 = static_cast<float>(cam.disparity(5.0)), d45 = static_cast<float>(cam.disparity(4.5));
+  const auto d5 = static_cast<float>(cam.disparity(5.0));
+  const auto d45 = static_cast<float>(cam.disparity(4.5));
   cv::Mat prev(40, 40, CV_32FC1, cv::Scalar(d5)), flow(40, 40, CV_32FC2, cv::Scalar(0, 0));
   cv::Mat xi;
   motion_likelihood(prev, prev, flow, cam, SceneFlowSegParams{}, xi);

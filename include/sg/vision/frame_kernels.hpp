@@ -12,10 +12,10 @@ namespace sg::vision {
 /// Throws core::InputError unless left/right are non-empty CV_8UC1 images of the same size.
 void check_frame(const core::StereoFrame& frame);
 
-/// SM on output rows `rows` with params.bm.matcher (bm, sgbm, fast or longseq): raw matching without the
-/// speckle filter (sgbm is not tileable: each tile matches the whole image, see stereo_sgbm.hpp). disp must be allocated
-/// as CV_32F of the frame size before tiles run (allocate_maps). Tiles stitched are bit-identical
-/// to one call over all rows.
+/// SM on output rows `rows` with params.bm.matcher (bm, sgbm, fast or longseq): raw matching
+/// without the speckle filter (sgbm is not tileable: each tile matches the whole image, see
+/// stereo_sgbm.hpp). disp must be allocated as CV_32F of the frame size before tiles run
+/// (allocate_maps). Tiles stitched are bit-identical to one call over all rows.
 void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& params,
                     cv::Mat& disp, cv::Range rows);
 /// SM finishing step over the whole map, after all tiles: the speckle filter.

@@ -29,7 +29,8 @@ struct SceneFlowSegParams {
   double sigma_change_px = 0.35;     ///< s_c: the disparity change's, px
   double xi_static = 2.8;  ///< the static label's likelihood: sqrt(7.81), chi-square(3) at 95 %
   double lambda = 6.0;     ///< weight of the smoothness term
-  double contrast_a = 4.0;  ///< a: keeps the smoothness finite across equal intensities, grey levels
+  /// a: keeps the smoothness finite across equal intensities, grey levels
+  double contrast_a = 4.0;
 };
 
 /// Each invalid field, by name ("sceneflow_seg.<field>=<value>: <rule>"); empty when valid.
