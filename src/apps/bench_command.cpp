@@ -31,7 +31,7 @@ struct BenchArgs {
 };
 
 void print_row(const pipeline::BenchRow& r) {
-  std::cout << std::left << std::setw(10) << r.kind << std::setw(12) << r.mode << std::right
+  std::cout << std::left << std::setw(10) << r.kind << std::setw(16) << r.mode << std::right
             << std::setw(5) << r.resolution.width << "x" << std::left << std::setw(5)
             << r.resolution.height << std::right << std::setw(3) << r.workers << std::setw(4)
             << r.tiles << std::setw(4) << r.tokens << std::fixed << std::setprecision(1)
@@ -105,7 +105,7 @@ void bench_main(const BenchArgs& a) {
   std::cout << "stereoguard bench: " << what << ", " << a.frames
             << " frames per configuration held in memory; pipeline rows: matcher " << a.matcher
             << " (baselines: bm)\n"
-            << "kind      mode          resolution  W   T tok  pace/s     fps  vs-mt   vs-1t"
+            << "kind      detector          resolution  W   T tok  pace/s     fps  vs-mt   vs-1t"
                "     p50     p99   drop  same\n"
             << "(vs-mt: speedup against the plain loop with OpenCV's threads, the default a user "
                "gets; vs-1t: against the same loop on one thread)\n";
@@ -127,7 +127,9 @@ void add_bench_command(CLI::App& app) {
   auto a = std::make_shared<BenchArgs>();
   CLI::App* cmd = app.add_subcommand(
       "bench", "throughput/latency sweep of modes x W x T against a plain OpenCV loop");
-  cmd->add_option("--modes", a->modes, "modes, comma-separated")->delimiter(',');
+  cmd->add_option("--detectors,--modes", a->modes,
+                  "detectors (as run's --detector), comma-separated (default stereo,stereo-flow)")
+      ->delimiter(',');
   cmd->add_option("--workers", a->workers, "W values, comma-separated")->delimiter(',');
   cmd->add_option("--tiles", a->tiles, "T values, comma-separated")->delimiter(',');
   cmd->add_option("--resolutions", a->resolutions, "e.g. 640x480,1242x375")->delimiter(',');

@@ -117,7 +117,9 @@ std::string input_platform(const OpenedInput& input) {
 
 void add_detector_options(CLI::App& app, DetectorOptions& o) {
   app.add_option("--config", o.config, "YAML config file (flags given too override it)");
-  app.add_option("--mode", o.mode, "stereo-flow (default) or stereo");
+  app.add_option("--detector,--mode", o.mode,
+                 "detector: stereo-flow (default), stereo, or one the thesis surveys: "
+                 "motion-parallax, relative-size, elevation-map, sceneflow-seg, longseq");
   app.add_option("--num-disparities", o.num_disparities,
                  "stereo search range, px (positive multiple of 16; default 64)");
   app.add_option("--block-size", o.block_size, "stereo block size, px (odd, 5..255)");
@@ -168,7 +170,7 @@ pipeline::RunOptions make_run_options(const DetectorOptions& o,
   run.tiles = settings.tiles;
   run.tokens = settings.tokens;
   run.threads = settings.threads;
-  if (o.mode) run.params.mode = core::parse_mode(*o.mode);
+  if (o.mode) core::select_detector(run.params, core::parse_mode(*o.mode));
   if (o.num_disparities) run.params.bm.num_disparities = *o.num_disparities;
   if (o.block_size) run.params.bm.block_size = *o.block_size;
   if (o.matcher) run.params.bm.matcher = core::parse_matcher(*o.matcher);

@@ -13,12 +13,49 @@ bool finite_positive(double v) { return std::isfinite(v) && v > 0; }
 
 }  // namespace
 
-const char* to_string(Mode m) { return m == Mode::kStereo ? "stereo" : "stereo-flow"; }
+const char* to_string(Mode m) {
+  switch (m) {
+    case Mode::kStereo: return "stereo";
+    case Mode::kStereoFlow: return "stereo-flow";
+    case Mode::kMotionParallax: return "motion-parallax";
+    case Mode::kRelativeSize: return "relative-size";
+    case Mode::kElevationMap: return "elevation-map";
+    case Mode::kSceneFlowSeg: return "sceneflow-seg";
+    case Mode::kLongSeq: return "longseq";
+  }
+  return "?";
+}
+
+std::vector<Mode> all_modes() {
+  return {Mode::kStereo,       Mode::kStereoFlow,   Mode::kMotionParallax, Mode::kRelativeSize,
+          Mode::kElevationMap, Mode::kSceneFlowSeg, Mode::kLongSeq};
+}
 
 Mode parse_mode(const std::string& text) {
-  if (text == "stereo") return Mode::kStereo;
-  if (text == "stereo-flow") return Mode::kStereoFlow;
-  throw InputError("mode=" + text + ": must be stereo or stereo-flow");
+  std::string names;
+  for (Mode m : all_modes()) {
+    if (text == to_string(m)) return m;
+    names += std::string(names.empty() ? "" : ", ") + to_string(m);
+  }
+  throw InputError("detector=" + text + ": must be one of " + names);
+}
+
+Needs needs(Mode m) {
+  switch (m) {
+    case Mode::kStereoFlow:
+    case Mode::kSceneFlowSeg: return {true, true};
+    case Mode::kMotionParallax: return {false, true};
+    case Mode::kRelativeSize: return {false, false};
+    case Mode::kStereo:
+    case Mode::kElevationMap:
+    case Mode::kLongSeq: return {true, false};
+  }
+  return {};
+}
+
+void select_detector(DetectorParams& p, Mode m) {
+  p.mode = m;
+  if (m == Mode::kLongSeq) p.bm.matcher = Matcher::kLongSeq;
 }
 
 const char* to_string(Matcher m) {
@@ -231,6 +268,19 @@ std::vector<std::string> validate(const DetectorParams& p, const Camera& camera)
   append(validate(p.signal));
   append(validate(p.flow));
   append(validate(p.scene_flow));
+  append(validate(p.motion_parallax));
+  append(validate(p.relative_size));
+  append(validate(p.elevation));
+  append(validate(p.sceneflow_seg));
+  append(validate(p.proximity));
+  if (p.mode == Mode::kLongSeq)
+    Checker(out, "stereo").require(p.bm.matcher == Matcher::kLongSeq, "matcher",
+                                   to_string(p.bm.matcher),
+                                   "must be longseq with the longseq detector");
+  if (p.mode == Mode::kLongSeq || p.mode == Mode::kElevationMap)
+    Checker(out, "proximity").require(p.proximity.alarm_distance_m > p.envelope.z_contact_m,
+                                      "alarm_distance_m", p.proximity.alarm_distance_m,
+                                      "must exceed envelope.z_contact_m");
   Checker c(out, "stereo");
   c.require(p.bm.min_disparity + p.bm.num_disparities < camera.width, "num_disparities",
             p.bm.num_disparities, "min_disparity + num_disparities must be below the image width");

@@ -93,6 +93,7 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
     std::string mode = core::to_string(p.mode);
     Section(root, "config")
         .field("mode", mode)
+        .field("detector", mode)
         .field("fps", settings.pace_fps)
         .field("workers", settings.workers)
         .field("tiles", settings.tiles)
@@ -108,9 +109,14 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .section("signal")
         .section("flow")
         .section("scene_flow")
+        .section("motion_parallax")
+        .section("relative_size")
+        .section("elevation")
+        .section("sceneflow_seg")
+        .section("proximity")
         .section("input")
         .done();
-    p.mode = core::parse_mode(mode);
+    core::select_detector(p, core::parse_mode(mode));
     std::string matcher = core::to_string(p.bm.matcher), cost = core::to_string(p.bm.cost);
     Section(root["stereo"], "stereo")
         .field("matcher", matcher)
@@ -207,6 +213,55 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
           .field("min_inliers", p.scene_flow.ground.min_inliers)
           .done();
     }
+    Section(root["motion_parallax"], "motion_parallax")
+        .field("smooth_px", p.motion_parallax.smooth_px)
+        .field("flow_min_px_s", p.motion_parallax.flow_min_px_s)
+        .done();
+    core::RelativeSizeParams& rs = p.relative_size;
+    Section(root["relative_size"], "relative_size")
+        .field("max_features", rs.max_features)
+        .field("ratio_test", rs.ratio_test)
+        .field("template_px", rs.template_px)
+        .field("patch_factor", rs.patch_factor)
+        .field("scale_max", rs.scale_max)
+        .field("scale_step", rs.scale_step)
+        .field("s_min", rs.s_min)
+        .field("max_error", rs.max_error)
+        .field("cluster_radius_px", rs.cluster_radius_px)
+        .field("cluster_min", rs.cluster_min)
+        .field("gap_frames", rs.gap_frames)
+        .done();
+    core::ElevationParams& el = p.elevation;
+    Section(root["elevation"], "elevation")
+        .field("sample_step_px", el.sample_step_px)
+        .field("fit_z_min_m", el.fit_z_min_m)
+        .field("fit_z_max_m", el.fit_z_max_m)
+        .field("fit_y_min_m", el.fit_y_min_m)
+        .field("iterations", el.iterations)
+        .field("tolerance_m", el.tolerance_m)
+        .field("min_inliers", el.min_inliers)
+        .field("seed", el.seed)
+        .field("cell_m", el.cell_m)
+        .field("half_width_m", el.half_width_m)
+        .field("z_max_m", el.z_max_m)
+        .field("height_min_m", el.height_min_m)
+        .field("density_ratio", el.density_ratio)
+        .field("min_points", el.min_points)
+        .done();
+    core::SceneFlowSegParams& sg = p.sceneflow_seg;
+    Section(root["sceneflow_seg"], "sceneflow_seg")
+        .field("sigma_disparity_px", sg.sigma_disparity_px)
+        .field("sigma_flow_px", sg.sigma_flow_px)
+        .field("sigma_change_px", sg.sigma_change_px)
+        .field("xi_static", sg.xi_static)
+        .field("lambda", sg.lambda)
+        .field("contrast_a", sg.contrast_a)
+        .field("grid_step_px", sg.grid_step_px)
+        .field("v_min_mps", sg.v_min_mps)
+        .done();
+    Section(root["proximity"], "proximity")
+        .field("alarm_distance_m", p.proximity.alarm_distance_m)
+        .done();
     io::SourceSpec& in = settings.input;
     Section(root["input"], "input")
         .field("left", in.left)

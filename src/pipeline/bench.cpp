@@ -206,9 +206,9 @@ std::vector<BenchRow> run_bench(const BenchConfig& config,
         input ? read_all(*input, config.frames) : render(scenario, config.frames);
     for (core::Mode mode : config.modes) {
       RunOptions options;
-      options.params.mode = mode;
       options.params.bm.num_disparities = config.num_disparities;
       options.params.bm.matcher = config.matcher;
+      core::select_detector(options.params, mode);  // longseq: its own matcher
       options.params.bm.cost = config.cost;
       options.threads = config.threads;
       options.tokens = config.tokens;

@@ -3,7 +3,7 @@
 namespace sg::pipeline {
 
 PlainLoop::PlainLoop(const core::DetectorParams& params, const core::Camera& camera)
-    : flow_mode_(params.mode == core::Mode::kStereoFlow),
+    : needs_(core::needs(params.mode)),
       bm_(cv::StereoBM::create(params.bm.num_disparities, params.bm.block_size)),
       dis_(cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_ULTRAFAST)),
       detector_(params, camera) {
@@ -17,9 +17,12 @@ PlainLoop::PlainLoop(const core::DetectorParams& params, const core::Camera& cam
 
 core::Detection PlainLoop::process(const core::StereoFrame& frame) {
   vision::FrameMaps maps;  // fresh maps: the detector keeps them in its history
-  bm_->compute(frame.left, frame.right, disp16_);
-  disp16_.convertTo(maps.disparity, CV_32F, 1.0 / 16);
-  if (flow_mode_ && !previous_left_.empty()) dis_->calc(frame.left, previous_left_, maps.flow);
+  if (needs_.disparity) {
+    bm_->compute(frame.left, frame.right, disp16_);
+    disp16_.convertTo(maps.disparity, CV_32F, 1.0 / 16);
+  }
+  maps.left = frame.left;
+  if (needs_.flow && !previous_left_.empty()) dis_->calc(frame.left, previous_left_, maps.flow);
   previous_left_ = frame.left;
   vision::LabelJob job = detector_.prepare(frame, std::move(maps));
   job.run(cv::Range::all());

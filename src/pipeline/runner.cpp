@@ -161,14 +161,17 @@ void tiled(int rows_total, int tiles, Kernel&& kernel) {
                           [&](int, int begin, int end) { kernel(cv::Range(begin, end)); });
 }
 
-/// The farm's first tasks for one frame: SM always (it decodes the frame), OF in Stereo-Flow mode
-/// from the second frame on (it needs this frame's and the previous frame's left image).
+/// The farm's first tasks for one frame, what the detector needs (core::needs): SM, which decodes
+/// the frame (or a decode alone for a detector without disparity), and OF from the second frame
+/// on (it needs this frame's and the previous frame's left image).
 par::TaskList make_tasks(FrameJob& job, const RunOptions& o) {
+  const core::Needs need = core::needs(o.params.mode);
   const bool flow_mode = o.params.mode == core::Mode::kStereoFlow;
-  const bool with_flow = flow_mode && job.previous;
+  const bool with_flow = need.flow && job.previous;
   par::TaskList tasks;
-  tasks.emplace_back([&job, &o, flow_mode] {
+  tasks.emplace_back([&job, &o, flow_mode, need] {
     const core::StereoFrame& frame = job.frame->get();
+    if (!need.disparity) return;
     const par::Stopwatch watch;
     vision::allocate_maps(frame.left.size(), false, job.maps.disparity, job.maps.flow);
     tiled(frame.left.rows, o.tiles, [&](cv::Range rows) {
@@ -204,6 +207,7 @@ par::TaskList relay_tasks(FrameJob& job, vision::Detector& detector, const RunOp
     job.kept_disparity = job.maps.disparity;
     job.kept_flow = job.maps.flow;
   }
+  job.maps.left = job.frame->get().left;
   job.label = detector.prepare(job.frame->header(), std::move(job.maps));
   const int bands =
       job.label.tileable() ? par::tile_count(job.label.rows(), std::max(o.workers, o.tiles)) : 1;
@@ -247,7 +251,7 @@ int effective_tokens(const RunOptions& o) {
 
 std::size_t heap_estimate(const RunOptions& o, int width, int height) {
   if (width <= 0 || height <= 0) return 0;
-  const bool flow = o.params.mode == core::Mode::kStereoFlow;
+  const bool flow = core::needs(o.params.mode).flow;
   const std::vector<int>& gaps = flow ? o.params.scene_flow.gaps : o.params.stereo.gaps;
   const int history = gaps.empty() ? 1 : *std::max_element(gaps.begin(), gaps.end());
   // Kept per past frame: disparity (4 B/px), and flow (8) and depth edges (1) for Stereo-Flow.

@@ -9,6 +9,7 @@
 #include "sg/vision/ego_motion.hpp"
 #include "sg/vision/labelling.hpp"
 #include "sg/vision/segment_motion.hpp"
+#include "sg/vision/surveyed.hpp"
 
 namespace sg::vision {
 
@@ -19,8 +20,50 @@ void depth_edges(const core::DetectorParams& params, const cv::Mat& disparity, c
     unmark_thin_structures(disparity, sf.edge_margin_px, sf.edge_step_px, edges);
 }
 
+void LabelJob::run_surveyed() {
+  const core::DetectorParams& p = *params_;
+  const cv::Size size = disparity_.size();
+  switch (mode_) {
+    case core::Mode::kMotionParallax:
+      if (span_s_ > 0)
+        label_motion_parallax(flows_.front(), span_s_, p.motion_parallax, p.signal.min_area_px,
+                              p.envelope.horizon_s, danger_, ttc_);
+      break;
+    case core::Mode::kRelativeSize:
+      if (span_s_ > 0)
+        label_relative_size(earlier_left_, left_, span_s_, p.relative_size, p.envelope.horizon_s,
+                            danger_, ttc_);
+      break;
+    case core::Mode::kElevationMap:
+      label_elevation_map(disparity_, *camera_, p.envelope, p.elevation, p.proximity, danger_,
+                          ttc_);
+      break;
+    case core::Mode::kLongSeq:
+      label_proximity(disparity_, cv::Mat(), *camera_, p.envelope, p.proximity, danger_, ttc_);
+      break;
+    case core::Mode::kSceneFlowSeg:
+      if (span_s_ > 0)
+        label_sceneflow_seg(left_, disparity_, past_.front(), flows_.front(), span_s_, *camera_,
+                            p.envelope, p.sceneflow_seg, p.signal.min_area_px, danger_, ttc_,
+                            velocity_);
+      break;
+    case core::Mode::kStereo:
+    case core::Mode::kStereoFlow:
+      break;
+  }
+  // Nothing to compare with yet: nothing is dangerous.
+  if (danger_.empty()) {
+    danger_ = cv::Mat::zeros(size, CV_8U);
+    ttc_ = cv::Mat(size, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  }
+}
+
 void LabelJob::run(cv::Range rows) {
   const core::DetectorParams& p = *params_;
+  if (mode_ != core::Mode::kStereo && mode_ != core::Mode::kStereoFlow) {
+    run_surveyed();
+    return;
+  }
   if (!flow_mode_) {
     std::vector<PastDisparity> past;
     for (size_t j = 0; j < past_.size(); ++j) past.push_back({steps_[j], &past_[j]});
@@ -44,19 +87,35 @@ Detector::Detector(const core::DetectorParams& params, const core::Camera& camer
       tracker_(params.signal, params.envelope.z_contact_m,
                camera.focal_px * camera.baseline_m / std::max(1, params.bm.num_disparities - 1)),
       severity_(params.signal) {
-  const std::vector<int>& gaps =
-      params_.mode == core::Mode::kStereoFlow ? params_.scene_flow.gaps : params_.stereo.gaps;
-  if (!gaps.empty()) max_gap_ = std::max(1, *std::max_element(gaps.begin(), gaps.end()));
+  if (params_.mode == core::Mode::kStereo || params_.mode == core::Mode::kStereoFlow) {
+    const std::vector<int>& gaps =
+        params_.mode == core::Mode::kStereoFlow ? params_.scene_flow.gaps : params_.stereo.gaps;
+    if (!gaps.empty()) max_gap_ = std::max(1, *std::max_element(gaps.begin(), gaps.end()));
+  } else if (params_.mode == core::Mode::kRelativeSize) {
+    max_gap_ = params_.relative_size.gap_frames;
+  }
 }
 
 LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
+  const core::Needs need = core::needs(params_.mode);
+  const bool with_left = !need.disparity || params_.mode == core::Mode::kRelativeSize ||
+                         params_.mode == core::Mode::kSceneFlowSeg;
+  if (with_left && (maps.left.empty() || maps.left.type() != CV_8UC1))
+    throw core::InputError("detector: " + std::string(core::to_string(params_.mode)) +
+                           " needs the left image, a non-empty CV_8U image");
+  if (!need.disparity) {
+    // A map of invalid disparities: the obstacles then have no distance.
+    maps.disparity = cv::Mat(maps.left.size(), CV_32F, cv::Scalar(-1.0f));
+  }
   const cv::Mat& disp = maps.disparity;
   if (disp.empty() || disp.type() != CV_32FC1)
     throw core::InputError("detector: the disparity map must be a non-empty CV_32F image");
+  if (with_left && maps.left.size() != disp.size())
+    throw core::InputError("detector: the left image and the disparity differ in size");
   if (!past_.empty() && past_.front().disparity.size() != disp.size())
     throw core::InputError("detector: the disparity map changed size within a stream");
   const bool flow_mode = params_.mode == core::Mode::kStereoFlow;
-  if (flow_mode && !maps.flow.empty() &&
+  if (need.flow && !maps.flow.empty() &&
       (maps.flow.type() != CV_32FC2 || maps.flow.size() != disp.size()))
     throw core::InputError("detector: the flow must be a CV_32FC2 map of the disparity's size");
   if (!past_.empty() && frame.index <= past_.front().index)
@@ -64,6 +123,7 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
 
   LabelJob job;
   cv::Matx33d flow_derotation = cv::Matx33d::eye();  // of maps.flow (compensate_rotation)
+  job.mode_ = params_.mode;
   job.flow_mode_ = flow_mode;
   job.params_ = &params_;
   job.camera_ = &camera_;
@@ -106,6 +166,8 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
     // Over the first frames of a chain the disparity error dominates the fit (startup_doubt_px).
     job.short_chain_ = params_.scene_flow.fit_velocity && reached < max_gap_;
     allocate_stereo_flow_outputs(disp.size(), job.danger_, job.ttc_, job.velocity_);
+  } else if (params_.mode != core::Mode::kStereo) {
+    prepare_surveyed(frame, maps, job);
   } else {
     for (int k : params_.stereo.gaps)
       if (k <= static_cast<int>(past_.size())) {
@@ -116,11 +178,44 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
   }
 
   // The maps are shared, not copied: nobody writes them after the workers are done.
-  Past entry{frame.index, frame.time_s, disp, flow_mode ? maps.edges : cv::Mat(),
-             flow_mode ? maps.flow : cv::Mat(), flow_derotation};
+  Past entry{frame.index,
+             frame.time_s,
+             disp,
+             flow_mode ? maps.edges : cv::Mat(),
+             params_.mode == core::Mode::kRelativeSize ? maps.left : cv::Mat(),
+             flow_mode ? maps.flow : cv::Mat(),
+             flow_derotation};
   past_.push_front(std::move(entry));
   while (static_cast<int>(past_.size()) > max_gap_) past_.pop_back();
   return job;
+}
+
+void Detector::prepare_surveyed(const core::StereoFrame& frame, const FrameMaps& maps,
+                                LabelJob& job) const {
+  job.left_ = maps.left;
+  if (past_.empty()) return;
+  const Past& previous = past_.front();
+  switch (params_.mode) {
+    case core::Mode::kMotionParallax:
+    case core::Mode::kSceneFlowSeg:
+      // The flow reaches the previous arrived frame (a dropped frame makes it a longer step).
+      if (maps.flow.empty()) return;
+      job.flows_.push_back(maps.flow);
+      job.past_.push_back(previous.disparity);
+      job.span_s_ = frame.time_s - previous.time_s;
+      break;
+    case core::Mode::kRelativeSize: {
+      // The oldest arrived frame at most gap_frames back (at least the previous one).
+      const Past* e = &previous;
+      for (const Past& q : past_)
+        if (frame.index - q.index <= params_.relative_size.gap_frames) e = &q;
+      job.earlier_left_ = e->left;
+      job.span_s_ = frame.time_s - e->time_s;
+      break;
+    }
+    default:
+      break;
+  }
 }
 
 void LabelJob::conclude() {
@@ -188,7 +283,8 @@ core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) 
 
 core::Detection Detector::process(const core::StereoFrame& frame, const FrameMaps& maps) {
   // The history shares the maps it keeps; a caller may reuse its buffers for the next frame.
-  FrameMaps own{maps.disparity.clone(), maps.flow.clone(), maps.edges.clone()};
+  FrameMaps own{maps.disparity.clone(), maps.flow.clone(), maps.edges.clone(),
+                maps.left.empty() ? frame.left : maps.left};
   LabelJob job = prepare(frame, std::move(own));
   job.run(cv::Range::all());
   return finish(frame, job);

@@ -52,33 +52,6 @@ void check_disparity(const cv::Mat& disp) {
 
 }  // namespace
 
-std::vector<std::string> validate(const ElevationParams& p) {
-  std::vector<std::string> out;
-  core::Checker c(out, "elevation");
-  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  c.require(p.sample_step_px >= 1 && p.sample_step_px <= 64, "sample_step_px", p.sample_step_px,
-            "must be in 1..64");
-  c.require(positive(p.fit_z_min_m), "fit_z_min_m", p.fit_z_min_m, "must be > 0 (m)");
-  c.require(positive(p.fit_z_max_m) && p.fit_z_max_m > p.fit_z_min_m, "fit_z_max_m",
-            p.fit_z_max_m, "must be > fit_z_min_m (m)");
-  c.require(std::isfinite(p.fit_y_min_m), "fit_y_min_m", p.fit_y_min_m, "must be finite (m)");
-  c.require(p.iterations >= 1 && p.iterations <= 100000, "iterations", p.iterations,
-            "must be in 1..100000");
-  c.require(positive(p.tolerance_m), "tolerance_m", p.tolerance_m, "must be > 0 (m)");
-  c.require(p.min_inliers >= 5, "min_inliers", p.min_inliers, "must be >= 5");
-  c.require(positive(p.cell_m), "cell_m", p.cell_m, "must be > 0 (m)");
-  c.require(positive(p.half_width_m), "half_width_m", p.half_width_m, "must be > 0 (m)");
-  c.require(positive(p.z_max_m), "z_max_m", p.z_max_m, "must be > 0 (m)");
-  c.require(!positive(p.cell_m) || !positive(p.half_width_m) || !positive(p.z_max_m) ||
-                (2.0 * p.half_width_m / p.cell_m) * (p.z_max_m / p.cell_m) <= 4.0e6,
-            "cell_m", p.cell_m, "makes more than 4e6 cells of the grid");
-  c.require(positive(p.height_min_m), "height_min_m", p.height_min_m, "must be > 0 (m)");
-  c.require(std::isfinite(p.density_ratio) && p.density_ratio > 1.0, "density_ratio",
-            p.density_ratio, "must be > 1");
-  c.require(p.min_points >= 1, "min_points", p.min_points, "must be >= 1");
-  return out;
-}
-
 RoadModel fit_road(const cv::Mat& disp, const core::Camera& cam, const ElevationParams& p) {
   check_disparity(disp);
   core::throw_if_invalid(validate(p), "invalid parameters");

@@ -39,6 +39,7 @@ void match_row_reference(const std::uint8_t* ref, const std::uint8_t* other, int
     if (best > best_max) continue;
     for (int d = 0; d < n; ++d)
       bad[static_cast<size_t>(d)] = cost[static_cast<size_t>(d)] > cost_max ? 1 : 0;
+    if (std::find(bad.begin(), bad.end(), 1) == bad.end()) continue;  // textureless
     out[x] = static_cast<float>(longest_good_run(bad.data(), n));
   }
 }
@@ -98,7 +99,13 @@ void match_row(const std::uint8_t* ref, const std::uint8_t* other, int width, in
     int best = cost[0];
     for (int d = 1; d < n; ++d) best = std::min(best, int{cost[d]});
     if (best > best_max) continue;
-    for (int d = 0; d < n; ++d) s.bad[static_cast<size_t>(d)] = cost[d] > cost_max ? 1 : 0;
+    // A window that matches at every disparity (no texture) says nothing: unmatched.
+    bool any_bad = false;
+    for (int d = 0; d < n; ++d) {
+      s.bad[static_cast<size_t>(d)] = cost[d] > cost_max ? 1 : 0;
+      any_bad |= cost[d] > cost_max;
+    }
+    if (!any_bad) continue;
     out[x] = static_cast<float>(longest_good_run(s.bad.data(), n));
   }
 }

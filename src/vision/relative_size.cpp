@@ -1,6 +1,9 @@
 #include "sg/vision/relative_size.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -12,20 +15,94 @@ namespace sg::vision {
 namespace {
 
 /// The template of side `side` centred at `at`, resampled bilinearly to n x n (CV_32F); false when
-/// it leaves the image.
+/// it leaves the image. Pixel (i, j) of the grid samples at + (side / n) * ((i, j) + 0.5 - n / 2).
 bool sample_template(const cv::Mat& image, cv::Point2f at, double side, int n, cv::Mat& out) {
   const double half = side / 2.0;
   if (at.x - half < 0.0 || at.y - half < 0.0 || at.x + half > image.cols - 1 ||
       at.y + half > image.rows - 1)
     return false;
-  // Pixel (i, j) of the grid samples at + (side / n) * ((i, j) + 0.5 - n / 2).
   const double k = side / n;
-  const cv::Matx23d affine(k, 0.0, at.x + k * (0.5 - n / 2.0),  //
-                           0.0, k, at.y + k * (0.5 - n / 2.0));
-  cv::warpAffine(image, out, affine, cv::Size(n, n), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
-                 cv::BORDER_REPLICATE);
-  out.convertTo(out, CV_32F);
+  const double x0 = at.x + k * (0.5 - n / 2.0), y0 = at.y + k * (0.5 - n / 2.0);
+  out.create(n, n, CV_32F);
+  for (int j = 0; j < n; ++j) {
+    // Inside [0, size - 1] by the check above; the last row and column have weight 0 beyond.
+    const double y = y0 + k * j;
+    const int iy = std::min(static_cast<int>(y), image.rows - 2);
+    const float fy = static_cast<float>(y - iy);
+    const std::uint8_t* r0 = image.ptr<std::uint8_t>(iy);
+    const std::uint8_t* r1 = image.ptr<std::uint8_t>(iy + 1);
+    float* o = out.ptr<float>(j);
+    for (int i = 0; i < n; ++i) {
+      const double x = x0 + k * i;
+      const int ix = std::min(static_cast<int>(x), image.cols - 2);
+      const float fx = static_cast<float>(x - ix);
+      const float top = r0[ix] + fx * (r0[ix + 1] - r0[ix]);
+      const float bottom = r1[ix] + fx * (r1[ix + 1] - r1[ix]);
+      o[i] = top + fy * (bottom - top);
+    }
+  }
   return true;
+}
+
+/// patch_scale over the logarithmic grid of scales exp(i log(1 + scale_step)), i in
+/// [i_min, i_max], the images and parameters already checked. With `stride` > 1 the grid is
+/// searched at every stride-th index first, then at every index within a stride of the best one
+/// (coarse to fine: the template error is smooth in the scale, its minimum a few steps wide).
+double search_scale(const cv::Mat& prev, const cv::Mat& cur, cv::Point2f at_prev,
+                    cv::Point2f at_cur, double side_px, const RelativeSizeParams& p, int i_min,
+                    int i_max, double* error, int stride = 1) {
+  cv::Mat reference, candidate;
+  if (!sample_template(prev, at_prev, side_px, p.template_px, reference)) return 0.0;
+  const double log_step = std::log1p(p.scale_step);
+  // The error at grid index i; infinity where the template leaves the image.
+  auto error_at = [&](int i) {
+    if (!sample_template(cur, at_cur, side_px * std::exp(i * log_step), p.template_px, candidate))
+      return std::numeric_limits<double>::infinity();
+    return cv::norm(reference, candidate, cv::NORM_L1) / static_cast<double>(reference.total());
+  };
+  int lo = i_min, hi = i_max;
+  if (stride > 1) {
+    int coarse = i_min;
+    double coarse_error = std::numeric_limits<double>::infinity();
+    for (int i = i_min; i <= i_max; i += stride) {
+      const double e = error_at(i);
+      if (e < coarse_error) coarse_error = e, coarse = i;
+    }
+    if (!std::isfinite(coarse_error)) return 0.0;
+    lo = std::max(i_min, coarse - stride);
+    hi = std::min(i_max, coarse + stride);
+  }
+  std::vector<double> errors;
+  std::vector<int> index;
+  for (int i = lo; i <= hi; ++i) {
+    const double e = error_at(i);
+    if (!std::isfinite(e)) continue;
+    index.push_back(i);
+    errors.push_back(e);
+  }
+  if (errors.empty()) return 0.0;
+  const size_t best = static_cast<size_t>(std::min_element(errors.begin(), errors.end()) -
+                                          errors.begin());
+  double log_s = index[best] * log_step;
+  // A parabola through the least error and its neighbours (on the log grid) refines it.
+  if (best > 0 && best + 1 < errors.size() && index[best - 1] + 1 == index[best] &&
+      index[best + 1] - 1 == index[best]) {
+    const double a = errors[best - 1], b = errors[best], c = errors[best + 1];
+    const double denominator = a - 2.0 * b + c;
+    if (denominator > 0.0) log_s += 0.5 * (a - c) / denominator * log_step;
+  }
+  if (error) *error = errors[best];
+  return std::exp(log_s);
+}
+
+/// expanding_features searches every kCoarseStride-th scale first (4 % apart), then every one
+/// near the best: 17 templates a feature instead of 44 (test
+/// RelativeSize.CoarseToFineFindsTheScaleOfTheFullSearch).
+constexpr int kCoarseStride = 4;
+
+/// The grid's largest index: exp(i log(1 + scale_step)) reaches scale_max.
+int scale_steps(const RelativeSizeParams& p) {
+  return static_cast<int>(std::ceil(std::log(p.scale_max) / std::log1p(p.scale_step)));
 }
 
 void check_images(const cv::Mat& prev, const cv::Mat& cur) {
@@ -36,59 +113,14 @@ void check_images(const cv::Mat& prev, const cv::Mat& cur) {
 
 }  // namespace
 
-std::vector<std::string> validate(const RelativeSizeParams& p) {
-  std::vector<std::string> out;
-  core::Checker c(out, "relative_size");
-  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  c.require(p.max_features >= 10 && p.max_features <= 100000, "max_features", p.max_features,
-            "must be in 10..100000");
-  c.require(positive(p.ratio_test) && p.ratio_test <= 1.0, "ratio_test", p.ratio_test,
-            "must be in (0, 1]");
-  c.require(p.template_px >= 4 && p.template_px <= 128, "template_px", p.template_px,
-            "must be in 4..128 (px)");
-  c.require(positive(p.patch_factor), "patch_factor", p.patch_factor, "must be > 0");
-  c.require(std::isfinite(p.scale_max) && p.scale_max > 1.0 && p.scale_max <= 4.0, "scale_max",
-            p.scale_max, "must be in (1, 4]");
-  c.require(positive(p.scale_step) && p.scale_step <= 0.1, "scale_step", p.scale_step,
-            "must be in (0, 0.1]");
-  c.require(std::isfinite(p.s_min) && p.s_min > 1.0, "s_min", p.s_min, "must be > 1");
-  c.require(positive(p.max_error), "max_error", p.max_error, "must be > 0 (grey levels)");
-  c.require(positive(p.cluster_radius_px), "cluster_radius_px", p.cluster_radius_px,
-            "must be > 0 (px)");
-  c.require(p.cluster_min >= 1, "cluster_min", p.cluster_min, "must be >= 1");
-  return out;
-}
-
 double patch_scale(const cv::Mat& prev, const cv::Mat& cur, cv::Point2f at_prev,
                    cv::Point2f at_cur, double side_px, const RelativeSizeParams& p,
-                   double* error) {
+                   double* error, int coarse_stride) {
   check_images(prev, cur);
   core::throw_if_invalid(validate(p), "invalid parameters");
-  cv::Mat reference, candidate;
-  if (!sample_template(prev, at_prev, side_px, p.template_px, reference)) return 0.0;
-  // Scales on a logarithmic grid, so that growing and shrinking are searched alike.
-  const double log_max = std::log(p.scale_max), log_step = std::log1p(p.scale_step);
-  const int steps = static_cast<int>(std::ceil(log_max / log_step));
-  std::vector<double> errors;
-  std::vector<double> scales;
-  for (int i = -steps; i <= steps; ++i) {
-    const double s = std::exp(i * log_step);
-    if (!sample_template(cur, at_cur, side_px * s, p.template_px, candidate)) continue;
-    scales.push_back(s);
-    errors.push_back(cv::norm(reference, candidate, cv::NORM_L1) / reference.total());
-  }
-  if (errors.empty()) return 0.0;
-  const size_t best = static_cast<size_t>(std::min_element(errors.begin(), errors.end()) -
-                                          errors.begin());
-  double log_s = std::log(scales[best]);
-  // A parabola through the least error and its neighbours (on the log grid) refines it.
-  if (best > 0 && best + 1 < errors.size()) {
-    const double a = errors[best - 1], b = errors[best], c = errors[best + 1];
-    const double denominator = a - 2.0 * b + c;
-    if (denominator > 0.0) log_s += 0.5 * (a - c) / denominator * log_step;
-  }
-  if (error) *error = errors[best];
-  return std::exp(log_s);
+  const int steps = scale_steps(p);
+  return search_scale(prev, cur, at_prev, at_cur, side_px, p, -steps, steps, error,
+                      std::max(1, coarse_stride));
 }
 
 std::vector<ExpandingFeature> expanding_features(const cv::Mat& prev, const cv::Mat& cur,
@@ -112,8 +144,11 @@ std::vector<ExpandingFeature> expanding_features(const cv::Mat& prev, const cv::
     // Only features whose detected size did not shrink can be expanding (the thesis keeps those
     // of bigger scale; ORB's pyramid levels are coarse, so equal sizes are kept too).
     if (b.size < a.size) continue;
+    // Growing scales only (from two steps below 1, so that a least error at 1 still has its
+    // parabola): a shrinking feature is not expanding whatever its exact scale.
     double error = 0.0;
-    const double s = patch_scale(prev, cur, a.pt, b.pt, a.size * p.patch_factor, p, &error);
+    const double s = search_scale(prev, cur, a.pt, b.pt, a.size * p.patch_factor, p, -2,
+                                  scale_steps(p), &error, kCoarseStride);
     if (s < p.s_min || error > p.max_error) continue;
     out.push_back({b.pt, s, -1});
   }

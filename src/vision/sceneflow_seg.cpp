@@ -63,22 +63,6 @@ void check_segmentation_inputs(const cv::Mat& image, const cv::Mat& xi,
 
 }  // namespace
 
-std::vector<std::string> validate(const SceneFlowSegParams& p) {
-  std::vector<std::string> out;
-  core::Checker c(out, "sceneflow_seg");
-  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  c.require(positive(p.sigma_disparity_px), "sigma_disparity_px", p.sigma_disparity_px,
-            "must be > 0 (px)");
-  c.require(positive(p.sigma_flow_px), "sigma_flow_px", p.sigma_flow_px, "must be > 0 (px)");
-  c.require(positive(p.sigma_change_px), "sigma_change_px", p.sigma_change_px,
-            "must be > 0 (px)");
-  c.require(std::isfinite(p.xi_static) && p.xi_static >= 0.0, "xi_static", p.xi_static,
-            "must be >= 0");
-  c.require(std::isfinite(p.lambda) && p.lambda >= 0.0, "lambda", p.lambda, "must be >= 0");
-  c.require(positive(p.contrast_a), "contrast_a", p.contrast_a, "must be > 0 (grey levels)");
-  return out;
-}
-
 void motion_likelihood(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const cv::Mat& flow,
                        const core::Camera& cam, const SceneFlowSegParams& p, cv::Mat& xi) {
   core::throw_if_invalid(validate(p), "invalid parameters");

@@ -177,6 +177,34 @@ TEST_F(Cli, UnknownOptionIsExitTwo) {
   EXPECT_EQ(r.status, 2);
 }
 
+TEST_F(Cli, EveryDetectorRunsAndNamesItsBadParameters) {
+  // Each surveyed detector evaluates the small scenario, and a bad field of its own section is
+  // one line naming it with exit status 2.
+  const std::string scenario = small_scenario(6).string();
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"motion-parallax", "motion_parallax: {smooth_px: 4}"},
+      {"relative-size", "relative_size: {gap_frames: 0}"},
+      {"elevation-map", "elevation: {height_min_m: -0.1}"},
+      {"sceneflow-seg", "sceneflow_seg: {sigma_flow_px: 0}"},
+      {"longseq", "proximity: {alarm_distance_m: 0.2}"}};
+  for (const auto& [detector, yaml] : bad) {
+    const Result ok = run("eval --quiet --scenario '" + scenario + "' --detector " + detector);
+    EXPECT_EQ(ok.status, 0) << detector << ": " << ok.err;
+    EXPECT_NE(ok.out.find("(mode " + detector + ")"), std::string::npos) << ok.out;
+    std::ofstream(dir_ / "bad.yaml") << yaml << "\n";
+    const std::string field = yaml.substr(0, yaml.find(':')) + "." +
+                              yaml.substr(yaml.find('{') + 1, yaml.find(':', yaml.find('{')) -
+                                                                  yaml.find('{') - 1);
+    expect_user_error(run("run --quiet --scenario '" + scenario + "' --detector " + detector +
+                          " --config bad.yaml"),
+                      field);
+  }
+  expect_user_error(run("run --scenario '" + scenario + "' --detector optic-flow"),
+                    "detector=optic-flow: must be one of");
+  expect_user_error(run("run --scenario '" + scenario + "' --detector longseq --matcher fast"),
+                    "stereo.matcher=fast: must be longseq with the longseq detector");
+}
+
 TEST_F(Cli, RepeatedRunsGiveByteIdenticalEvents) {
   const std::string scenario = small_scenario().string();
   ASSERT_EQ(run("run --quiet --no-timing --scenario '" + scenario + "' --events a.jsonl").status, 0);

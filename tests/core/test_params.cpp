@@ -45,6 +45,63 @@ TEST(Params, LongSeqMatcherRulesNameTheirFields) {
   EXPECT_THROW(parse_matcher("long-seq"), InputError);
 }
 
+TEST(Params, DetectorsByNameWithWhatTheyNeed) {
+  for (const Mode m : all_modes()) EXPECT_EQ(parse_mode(to_string(m)), m);
+  EXPECT_EQ(all_modes().size(), 7u);
+  EXPECT_EQ(parse_mode("motion-parallax"), Mode::kMotionParallax);
+  const std::string message = [] {
+    try {
+      parse_mode("optic");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  }();
+  EXPECT_NE(message.find("detector=optic: must be one of stereo, stereo-flow, motion-parallax, "
+                         "relative-size, elevation-map, sceneflow-seg, longseq"),
+            std::string::npos)
+      << message;
+  // Monocular detectors need no disparity; only the motion detectors need flow.
+  EXPECT_FALSE(needs(Mode::kMotionParallax).disparity);
+  EXPECT_TRUE(needs(Mode::kMotionParallax).flow);
+  EXPECT_FALSE(needs(Mode::kRelativeSize).disparity);
+  EXPECT_FALSE(needs(Mode::kRelativeSize).flow);
+  EXPECT_TRUE(needs(Mode::kSceneFlowSeg).disparity && needs(Mode::kSceneFlowSeg).flow);
+  EXPECT_TRUE(needs(Mode::kElevationMap).disparity && !needs(Mode::kElevationMap).flow);
+  EXPECT_TRUE(needs(Mode::kStereoFlow).flow && !needs(Mode::kStereo).flow);
+  // The longseq detector brings its matcher; another one is an error naming the field.
+  DetectorParams p;
+  select_detector(p, Mode::kLongSeq);
+  EXPECT_EQ(p.bm.matcher, Matcher::kLongSeq);
+  EXPECT_TRUE(validate(p, Camera{}).empty());
+  p.bm.matcher = Matcher::kFast;
+  EXPECT_TRUE(mentions(validate(p, Camera{}),
+                       "stereo.matcher=fast: must be longseq with the longseq detector"));
+}
+
+TEST(Params, SurveyedDetectorRulesNameTheirFields) {
+  DetectorParams p;
+  p.motion_parallax.smooth_px = 4;
+  p.motion_parallax.flow_min_px_s = 0;
+  p.relative_size.gap_frames = 0;
+  p.relative_size.ratio_test = 1.5;
+  p.elevation.cell_m = -1;
+  p.sceneflow_seg.grid_step_px = 0;
+  p.sceneflow_seg.lambda = -2;
+  p.proximity.alarm_distance_m = 0.3;
+  std::vector<std::string> problems = validate(p, Camera{});
+  for (const char* field :
+       {"motion_parallax.smooth_px=4", "motion_parallax.flow_min_px_s=0",
+        "relative_size.gap_frames=0", "relative_size.ratio_test=1.5", "elevation.cell_m=-1",
+        "sceneflow_seg.grid_step_px=0", "sceneflow_seg.lambda=-2"})
+    EXPECT_TRUE(mentions(problems, field)) << field;
+  // The alarm distance must lie beyond the contact depth for the detectors that use it.
+  EXPECT_FALSE(mentions(problems, "proximity.alarm_distance_m"));
+  p.mode = Mode::kElevationMap;
+  EXPECT_TRUE(mentions(validate(p, Camera{}),
+                       "proximity.alarm_distance_m=0.3: must exceed envelope.z_contact_m"));
+}
+
 TEST(Params, NumDisparitiesMustBePositiveMultipleOf16) {
   for (int n : {0, -16, 70}) {
     DetectorParams p;

@@ -136,7 +136,7 @@ TEST(Config, BadModeMissingFileAndBadYaml) {
   core::DetectorParams p;
   RunSettings s;
   EXPECT_NE(input_error_of([&] { apply_config_file(write_file(dir, "mode: mono\n"), p, s); })
-                .find("mode=mono"),
+                .find("detector=mono"),
             std::string::npos);
   EXPECT_NE(input_error_of([&] { apply_config_file(dir.path() / "nope.yaml", p, s); })
                 .find("does not exist"),
@@ -165,6 +165,37 @@ TEST(Config, StereoMatcherAndCost) {
   EXPECT_DOUBLE_EQ(p.bm.longseq_cost_max, 9.5);
   EXPECT_DOUBLE_EQ(p.bm.longseq_best_max, 4.0);
   EXPECT_FALSE(p.bm.longseq_both_ways);
+}
+
+TEST(Config, DetectorAndTheSurveyedDetectorsSections) {
+  ScratchDir dir;
+  core::DetectorParams p;
+  RunSettings s;
+  auto path = write_file(dir,
+                         "detector: relative-size\n"
+                         "motion_parallax: {smooth_px: 5, flow_min_px_s: 9}\n"
+                         "relative_size: {gap_frames: 6, cluster_min: 3}\n"
+                         "elevation: {cell_m: 0.25, seed: 7}\n"
+                         "sceneflow_seg: {grid_step_px: 2, v_min_mps: 0.5}\n"
+                         "proximity: {alarm_distance_m: 6}\n");
+  apply_config_file(path, p, s);
+  EXPECT_EQ(p.mode, core::Mode::kRelativeSize);
+  EXPECT_EQ(p.motion_parallax.smooth_px, 5);
+  EXPECT_DOUBLE_EQ(p.motion_parallax.flow_min_px_s, 9.0);
+  EXPECT_EQ(p.relative_size.gap_frames, 6);
+  EXPECT_EQ(p.relative_size.cluster_min, 3);
+  EXPECT_DOUBLE_EQ(p.elevation.cell_m, 0.25);
+  EXPECT_EQ(p.elevation.seed, 7u);
+  EXPECT_EQ(p.sceneflow_seg.grid_step_px, 2);
+  EXPECT_DOUBLE_EQ(p.sceneflow_seg.v_min_mps, 0.5);
+  EXPECT_DOUBLE_EQ(p.proximity.alarm_distance_m, 6.0);
+  // The longseq detector selects its matcher; a key of no section is an error naming it.
+  path = write_file(dir, "mode: longseq\n");
+  apply_config_file(path, p, s);
+  EXPECT_EQ(p.bm.matcher, core::Matcher::kLongSeq);
+  path = write_file(dir, "elevation: {cell_size: 1}\n");
+  const std::string message = input_error_of([&] { apply_config_file(path, p, s); });
+  EXPECT_NE(message.find("elevation.cell_size"), std::string::npos) << message;
 }
 
 }  // namespace

@@ -130,6 +130,41 @@ TEST(Pipeline, LongSeqMatcherTilesAndWorkersGiveTheSequentialDetections) {
   }
 }
 
+/// The detectors the thesis surveys (vision/surveyed.hpp).
+class SurveyedDetector : public ::testing::TestWithParam<core::Mode> {};
+
+TEST_P(SurveyedDetector, FiresOnTheApproachAndEveryConfigurationGivesTheSequentialDetections) {
+  // Each computes only what it needs (SM, OF, neither), in the farm's tasks; its labelling runs
+  // once per frame; workers, tiles and tokens change nothing.
+  RunOptions reference = options_for(GetParam());
+  core::select_detector(reference.params, GetParam());
+  RunSummary s;
+  const std::vector<std::string> expected = detections(head_on(), reference, &s);
+  ASSERT_EQ(expected.size(), head_on().frames.size());
+  EXPECT_GT(s.alarm_frames, 0) << core::to_string(GetParam());
+  const core::Needs need = core::needs(GetParam());
+  EXPECT_EQ(s.busy_sm_ms > 0, need.disparity);
+  EXPECT_EQ(s.busy_of_ms > 0, need.flow);
+  for (const auto& [w, t, tokens] : {std::tuple{2, 1, 0}, std::tuple{1, 3, 0},
+                                     std::tuple{2, 2, 0}, std::tuple{3, 2, 1}}) {
+    RunOptions o = reference;
+    o.workers = w;
+    o.tiles = t;
+    o.tokens = tokens;
+    EXPECT_EQ(detections(head_on(), o), expected) << "W " << w << " T " << t << " tok " << tokens;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Detectors, SurveyedDetector,
+                         ::testing::Values(core::Mode::kMotionParallax, core::Mode::kRelativeSize,
+                                           core::Mode::kElevationMap, core::Mode::kSceneFlowSeg,
+                                           core::Mode::kLongSeq),
+                         [](const auto& info) {
+                           std::string name = core::to_string(info.param);
+                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
+                           return name;
+                         });
+
 TEST_P(EveryConfiguration, PlainLoopGivesThePipelineDetections) {
   // The baseline of bench and bench_process.sh does the same work: StereoBM, DIS ultrafast and
   // the detector, one frame at a time.

@@ -4,6 +4,7 @@
 
 #include "sg/core/error.hpp"
 #include "sg/vision/elevation_map.hpp"
+#include "sg/vision/surveyed.hpp"
 
 namespace sg::vision {
 namespace {
@@ -95,6 +96,34 @@ TEST(ElevationMap, MarksABoxOnTheRoadAsAnObstacleAndTheRoadAsRoad) {
     const cv::Point ground = cam.project({0.0, truth.y(0.0, 4.0), 4.0});
     EXPECT_EQ(mask.at<std::uint8_t>(ground), 0);
   }
+}
+
+TEST(ElevationMapDetector, MarksANearBoxOnTheRoadNotTheRoadNorAFarBox) {
+  const core::Camera cam = camera();
+  const core::Envelope envelope;     // |X| <= 0.5 m, -1 <= Y <= 1 m
+  const core::ProximityParams near;  // 4 m
+  const RoadModel truth = road(0.004, 0.01, -0.002, -0.01, 1.2);
+  cv::Mat danger, ttc;
+  label_elevation_map(render(cam, truth, 3.0), cam, envelope, ElevationParams{}, near, danger,
+                      ttc);
+  // The box's face within the envelope's band (its top 0.6 m of 0.8 m are above Y = 1).
+  const cv::Point box = cam.project({0.0, truth.y(0.0, 3.0) - 0.5, 3.0});
+  EXPECT_EQ(danger.at<std::uint8_t>(box), 255);
+  const cv::Point ground = cam.project({1.5, truth.y(1.5, 3.0), 3.0});  // beside the box
+  EXPECT_EQ(danger.at<std::uint8_t>(ground), 0);
+  EXPECT_GT(cv::countNonZero(danger), 1000);
+  // Only the box: each dangerous pixel lies within the box's image, 3 m away.
+  const cv::Point top_left = cam.project({-0.6, truth.y(-0.6, 3.0) - 0.8, 3.0});
+  const cv::Point bottom_right = cam.project({0.6, truth.y(0.6, 3.0), 3.0});
+  const cv::Rect image_of_box(top_left - cv::Point(2, 2), bottom_right + cv::Point(3, 3));
+  EXPECT_EQ(cv::countNonZero(danger(image_of_box)), cv::countNonZero(danger));
+  // 6 m away it is an obstacle of the map but beyond the alarm distance; no box, no danger.
+  label_elevation_map(render(cam, truth, 6.0), cam, envelope, ElevationParams{}, near, danger,
+                      ttc);
+  EXPECT_EQ(cv::countNonZero(danger), 0);
+  label_elevation_map(render(cam, truth, -1.0), cam, envelope, ElevationParams{}, near, danger,
+                      ttc);
+  EXPECT_EQ(cv::countNonZero(danger), 0);
 }
 
 TEST(ElevationMap, NoRoadWithoutGroundAndBadParametersByName) {

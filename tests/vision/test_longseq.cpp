@@ -102,10 +102,12 @@ TEST(LongSeq, RunningSumsEqualTheReferenceAndRowTilesTheWholeImage) {
         right.at<std::uint8_t>(y, x) = cv::saturate_cast<std::uint8_t>(
             left.at<std::uint8_t>(y, std::min(size.width - 1, x + shift)) + rng.uniform(-4, 5));
     LongSeqParams p;
-    p.num_disparities = rng.uniform(1, 24);
+    p.num_disparities = rng.uniform(shift + 2, 24);  // the true disparity within the range
     p.window_px = 2 * rng.uniform(0, 4) + 1;
-    p.cost_max = rng.uniform(2.0, 20.0);
-    p.best_max = rng.uniform(0.0, p.cost_max);
+    // (Up to 10: with more, every disparity of a blurred texture can match, and such pixels are
+    // unmatched.)
+    p.cost_max = rng.uniform(2.0, 10.0);
+    p.best_max = rng.uniform(p.cost_max / 2, p.cost_max);
     p.both_ways = trial % 2 == 0;
     cv::Mat fast, reference;
     longseq_disparity(left, right, p, fast);
@@ -120,16 +122,23 @@ TEST(LongSeq, RunningSumsEqualTheReferenceAndRowTilesTheWholeImage) {
   }
 }
 
-TEST(LongSeq, AFlatImageHasNoLongestRunToTrust) {
-  // Every disparity matches a uniform image equally: one run over the whole range. The method
-  // picks its middle; this documents the known weakness (no texture, no depth).
-  cv::Mat flat(20, 100, CV_8UC1, cv::Scalar(90));
+TEST(LongSeq, AFlatImageHasNoLongestRunToTrustAndIsUnmatched) {
+  // Every disparity matches a uniform image equally: one run over the whole range, whose middle
+  // the thesis' rule would take (a near point on every patch of sky). Such pixels are unmatched,
+  // in the reference and the fast path; a textured row beside them still matches.
+  cv::Mat left(20, 100, CV_8UC1, cv::Scalar(90));
+  for (int x = 0; x < 100; ++x) left.at<std::uint8_t>(5, x) = static_cast<std::uint8_t>((x * 37) % 200);
+  cv::Mat right = left.clone();
   LongSeqParams p;
   p.num_disparities = 16;
   p.both_ways = false;
-  cv::Mat disp;
-  longseq_disparity(flat, flat, p, disp);
-  EXPECT_EQ(disp.at<float>(10, 50), 7.0f);
+  cv::Mat disp, reference;
+  longseq_disparity(left, right, p, disp);
+  longseq_disparity_reference(left, right, p, reference);
+  EXPECT_EQ(disp.at<float>(10, 50), -1.0f);
+  EXPECT_EQ(reference.at<float>(10, 50), -1.0f);
+  EXPECT_EQ(disp.at<float>(5, 50), 0.0f);
+  EXPECT_EQ(cv::norm(disp, reference, cv::NORM_INF), 0.0);
 }
 
 TEST(LongSeq, RejectsBadInputAndParametersByName) {

@@ -42,6 +42,27 @@ TEST(RelativeSize, RecoversAKnownScaleChangeOfATexturedPatchWithin2Percent) {
   EXPECT_EQ(patch_scale(prev, prev, {5.0f, 5.0f}, {5.0f, 5.0f}, 36.0, p), 0.0);
 }
 
+TEST(RelativeSize, CoarseToFineFindsTheScaleOfTheFullSearch) {
+  const cv::Mat prev = texture({320, 240}, 7, 2.0);
+  const RelativeSizeParams p;
+  int trials = 0;
+  cv::RNG rng(11);
+  for (int k = 0; k < 40; ++k) {
+    const double s = rng.uniform(0.85, 1.4);
+    const cv::Point2f from(rng.uniform(80.0f, 240.0f), rng.uniform(70.0f, 170.0f));
+    const cv::Point2f to = from + cv::Point2f(rng.uniform(-8.0f, 8.0f), rng.uniform(-8.0f, 8.0f));
+    const cv::Mat cur = scaled(prev, s, from, to);
+    double full_error = 0.0, coarse_error = 0.0;
+    const double full = patch_scale(prev, cur, from, to, 30.0, p, &full_error);
+    const double coarse = patch_scale(prev, cur, from, to, 30.0, p, &coarse_error, 4);
+    if (full == 0.0) continue;
+    ++trials;
+    EXPECT_DOUBLE_EQ(coarse, full) << "scale " << s;
+    EXPECT_DOUBLE_EQ(coarse_error, full_error) << "scale " << s;
+  }
+  EXPECT_GT(trials, 30);
+}
+
 TEST(RelativeSize, AnExpandingTexturedSquareIsAClusterTheStaticBackgroundIsNot) {
   // A static background and, in front of it, a textured square that grows by 12 %.
   const cv::Size size(480, 360);

@@ -6,14 +6,37 @@
 #include <vector>
 
 #include "sg/core/camera.hpp"
+#include "sg/core/surveyed_params.hpp"
 
 namespace sg::core {
 
-enum class Mode { kStereo, kStereoFlow };
-/// "stereo" / "stereo-flow".
+/// The detector (DESIGN 3.4): ours, Stereo (depth decreases, DESIGN 3.1) and Stereo-Flow (the 3D
+/// motion heads into the envelope, DESIGN 3.2), and the five the thesis surveys in chapter 3
+/// (vision/surveyed.hpp). `--mode` and `--detector` name the same choice.
+enum class Mode {
+  kStereo,
+  kStereoFlow,
+  kMotionParallax,  ///< monocular: blobs of the flow that expand (thesis 3.1.1)
+  kRelativeSize,    ///< monocular: clusters of features that grow (thesis 3.1.2)
+  kElevationMap,    ///< obstacles standing on a fitted road, nearer than a distance (3.2.1)
+  kSceneFlowSeg,    ///< moving blobs of a graph cut whose scene flow enters the envelope (3.2.2)
+  kLongSeq,         ///< the LongSeq matcher's points nearer than a distance (thesis 3.2.3)
+};
+/// "stereo", "stereo-flow", "motion-parallax", "relative-size", "elevation-map",
+/// "sceneflow-seg", "longseq".
 const char* to_string(Mode m);
-/// Parses "stereo" / "stereo-flow"; throws InputError otherwise.
+/// Parses the names of to_string; throws InputError naming them otherwise.
 Mode parse_mode(const std::string& text);
+/// Every detector, in the order of the enum.
+std::vector<Mode> all_modes();
+
+/// What a detector needs computed for a frame besides its left image, so that the pipeline
+/// computes only that.
+struct Needs {
+  bool disparity = true;  ///< stereo matching (SM)
+  bool flow = false;      ///< the backward flow to the previous frame's left image (OF)
+};
+Needs needs(Mode m);
 
 /// Stereo matcher (DESIGN 2.1): OpenCV StereoBM, OpenCV StereoSGBM, our own SIMD matcher, or
 /// LongSeq (thesis 3.2.3, vision/longseq.hpp: the longest run of good matches over one row).
@@ -270,7 +293,16 @@ struct DetectorParams {
   SignalParams signal;
   FlowParams flow;            ///< Stereo-Flow mode only
   SceneFlowParams scene_flow;  ///< Stereo-Flow mode only
+  // The surveyed detectors' own settings (core/surveyed_params.hpp).
+  MotionParallaxParams motion_parallax;  ///< motion-parallax
+  RelativeSizeParams relative_size;      ///< relative-size
+  ElevationParams elevation;             ///< elevation-map
+  SceneFlowSegParams sceneflow_seg;      ///< sceneflow-seg
+  ProximityParams proximity;             ///< elevation-map and longseq
 };
+
+/// Sets p.mode to m; the longseq detector also selects the LongSeq matcher.
+void select_detector(DetectorParams& p, Mode m);
 
 /// Every violation as "<section>.<field>=<value>: <rule>"; empty when valid.
 std::vector<std::string> validate(const BmParams& p);
@@ -283,7 +315,9 @@ std::vector<std::string> validate(const FlowParams& p);
 std::vector<std::string> validate(const GroundParams& p);
 /// "scene_flow.<field>=<value>: <rule>" (and ground.* when exclude_ground).
 std::vector<std::string> validate(const SceneFlowParams& p);
-/// All of the above plus checks against the image size (num_disparities < width, etc.).
+/// All of the above (and core/surveyed_params.hpp's) plus the rules between sections (the
+/// longseq detector matches with longseq; the alarm distance lies beyond the contact depth) and
+/// checks against the image size (num_disparities < width, etc.).
 std::vector<std::string> validate(const DetectorParams& p, const Camera& camera);
 
 }  // namespace sg::core

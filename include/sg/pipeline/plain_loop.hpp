@@ -18,7 +18,7 @@ namespace sg::pipeline {
 class PlainLoop {
  public:
   /// params must be valid (core::validate); params.bm sets StereoBM (the matcher field is
-  /// ignored: the plain loop is StereoBM), params.mode whether flow is computed.
+  /// ignored: the plain loop is StereoBM), params.mode what it computes (core::needs).
   PlainLoop(const core::DetectorParams& params, const core::Camera& camera);
 
   /// Frames in stream order: disparity, flow to the previous frame's left image (Stereo-Flow,
@@ -26,7 +26,7 @@ class PlainLoop {
   core::Detection process(const core::StereoFrame& frame);
 
  private:
-  bool flow_mode_;
+  core::Needs needs_;
   cv::Ptr<cv::StereoBM> bm_;
   cv::Ptr<cv::DISOpticalFlow> dis_;
   vision::Detector detector_;

@@ -26,13 +26,17 @@ namespace sg::vision {
 
 /// What the workers computed for one frame.
 struct FrameMaps {
-  cv::Mat disparity;  ///< CV_32F, px, invalid < 0
+  /// CV_32F, px, invalid < 0; empty for the detectors that do not need it (core::needs).
+  cv::Mat disparity;
   /// CV_32FC2 backward flow B_i from L_i to the left image of the previous frame that reached the
   /// detector (Stereo-Flow mode), empty for the first frame and in Stereo mode.
   cv::Mat flow;
   /// Optional CV_8U depth-edge mask of `disparity` (depth_edges()); computed by prepare() when
   /// empty in Stereo-Flow mode. A worker may compute it right after the disparity.
   cv::Mat edges;
+  /// The frame's left image (CV_8U), a share: relative-size and sceneflow-seg read it (and the
+  /// earlier frames' from the history). Detector::process takes the frame's when empty.
+  cv::Mat left;
 };
 
 /// The depth-edge mask the Stereo-Flow labelling uses for `disparity` (mark_depth_edges with the
@@ -60,6 +64,10 @@ class LabelJob {
 
  private:
   friend class Detector;
+  /// The surveyed detectors' labelling (vision/surveyed.hpp), over the whole image.
+  void run_surveyed();
+
+  core::Mode mode_ = core::Mode::kStereo;
   bool flow_mode_ = false;
   const core::DetectorParams* params_ = nullptr;
   const core::Camera* camera_ = nullptr;
@@ -73,6 +81,11 @@ class LabelJob {
   /// the current orientation; empty = no compensation.
   std::vector<cv::Matx33d> derotations_;
   cv::Mat danger_, ttc_, velocity_;
+  // The surveyed detectors: the left images compared (relative-size: the earlier one of the
+  // gap; sceneflow-seg: the current one), and the time between the frames compared, s; 0 when
+  // the history holds nothing to compare with (nothing is dangerous then).
+  cv::Mat left_, earlier_left_;
+  double span_s_ = 0.0;
   /// Stereo-Flow with the velocity fit: the chain does not reach the longest gap yet (the start
   /// of a stream), so pooling doubts the fit by scene_flow.startup_doubt_px.
   bool short_chain_ = false;
@@ -96,8 +109,11 @@ class Detector {
   /// (label_stereo_flow_rows). A dropped frame thus shortens the chains instead of restarting
   /// them; an empty maps.flow cuts the chain there. With scene_flow.compensate_rotation the
   /// camera's rotation is estimated from each flow (estimate_ego_motion) and removed over every
-  /// gap. Throws core::InputError when the disparity is
-  /// not a non-empty CV_32F map, when a non-empty flow is not CV_32FC2 of its size, when the size
+  /// gap. The surveyed detectors (vision/surveyed.hpp) compare with the previous arrived frame
+  /// (motion-parallax: its flow; sceneflow-seg: its disparity and the flow), relative-size with
+  /// the oldest arrived frame at most relative_size.gap_frames back (its left image). Throws
+  /// core::InputError when the detector needs a disparity and it is not a non-empty CV_32F map,
+  /// when relative-size or a detector without disparity gets no CV_8U left image, when a non-empty flow is not CV_32FC2 of its size, when the size
   /// changes within the stream, or when frames come out of order.
   LabelJob prepare(const core::StereoFrame& frame, FrameMaps maps);
 
@@ -121,11 +137,16 @@ class Detector {
     double time_s = 0.0;
     cv::Mat disparity;
     cv::Mat edges;  ///< Stereo-Flow
+    cv::Mat left;   ///< relative-size
     cv::Mat flow;   ///< Stereo-Flow: its flow to the next older entry; empty = chain cut
     /// With compensate_rotation: turns the next older entry's camera coordinates into this
     /// entry's orientation (from `flow`, estimate_ego_motion).
     cv::Matx33d derotation = cv::Matx33d::eye();
   };
+
+  /// prepare's part for the surveyed detectors: what the frame is compared with.
+  void prepare_surveyed(const core::StereoFrame& frame, const FrameMaps& maps,
+                        LabelJob& job) const;
 
   core::DetectorParams params_;
   core::Camera camera_;

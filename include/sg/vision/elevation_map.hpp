@@ -13,33 +13,13 @@
 #include <vector>
 
 #include "sg/core/camera.hpp"
+#include "sg/core/surveyed_params.hpp"
 
 namespace sg::vision {
 
-struct ElevationParams {
-  int sample_step_px = 2;      ///< every n-th row and column makes the point cloud, >= 1
-  // The road fit: points of the cloud in front of and below the camera (the thesis' "cubic region
-  // with small Z and small Y").
-  double fit_z_min_m = 1.0;    ///< nearest fitted point, m
-  double fit_z_max_m = 12.0;   ///< farthest fitted point, m
-  double fit_y_min_m = 0.2;    ///< fitted points lie at least this far below the optical axis, m
-  int iterations = 300;        ///< RANSAC samples of 5 points, >= 1
-  double tolerance_m = 0.04;   ///< inlier distance to the road (vertical), m
-  int min_inliers = 100;       ///< fewer inliers: no road found
-  std::uint64_t seed = 12345;  ///< fixed RANSAC seed (reproducible)
-  // The grid.
-  double cell_m = 0.5;        ///< side L of a square XZ cell, m
-  double half_width_m = 5.0;  ///< the grid spans X in [-half_width, half_width], m
-  double z_max_m = 20.0;      ///< and Z in (0, z_max], m
-  double height_min_m = 0.25;  ///< Delta h: a cell's mean height above this is an obstacle, m
-  /// Th: a cell holding at least this many times the points a flat road would give it is an
-  /// obstacle (a surface facing the camera projects many more pixels into one cell than the road).
-  double density_ratio = 3.0;
-  int min_points = 6;  ///< a cell with fewer points is empty (no evidence either way)
-};
+using ElevationParams = core::ElevationParams;
 
-/// Each invalid field, by name ("elevation.<field>=<value>: <rule>"); empty when valid.
-std::vector<std::string> validate(const ElevationParams& p);
+using core::validate;
 
 struct RoadModel {
   double a2 = 0.0, a1 = 0.0, b2 = 0.0, b1 = 0.0, c = 0.0;

@@ -8,7 +8,10 @@
 /// window at x and the right image's at x - d (window_px pixels of the same row):
 ///   the pixel is matched at all when min_d C(x, d) <= best_max;
 ///   B(x, d) = 1 (bad) when C(x, d) > cost_max, 0 (good) otherwise;
-///   the disparity is the middle of the longest run of zeros of B (the first such run on a tie).
+///   the disparity is the middle of the longest run of zeros of B (the first such run on a tie);
+///   a pixel with no bad entry at all (an untextured window, which matches everywhere) is left
+///   unmatched: its run spans the whole range and says nothing (the thesis' rule would give the
+///   range's middle, a near point, on every patch of sky or blank wall).
 /// The thesis' example: B = [110001001] gives the run lengths [113331221] and a disparity inside
 /// the run of three zeros, d = 3.
 #include <cstdint>

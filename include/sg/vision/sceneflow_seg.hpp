@@ -20,21 +20,13 @@
 #include <vector>
 
 #include "sg/core/camera.hpp"
+#include "sg/core/surveyed_params.hpp"
 
 namespace sg::vision {
 
-struct SceneFlowSegParams {
-  double sigma_disparity_px = 0.25;  ///< s_d: the disparity's standard deviation, px
-  double sigma_flow_px = 0.5;        ///< s_u = s_v: the flow's, px
-  double sigma_change_px = 0.35;     ///< s_c: the disparity change's, px
-  double xi_static = 2.8;  ///< the static label's likelihood: sqrt(7.81), chi-square(3) at 95 %
-  double lambda = 6.0;     ///< weight of the smoothness term
-  /// a: keeps the smoothness finite across equal intensities, grey levels
-  double contrast_a = 4.0;
-};
+using SceneFlowSegParams = core::SceneFlowSegParams;
 
-/// Each invalid field, by name ("sceneflow_seg.<field>=<value>: <rule>"); empty when valid.
-std::vector<std::string> validate(const SceneFlowSegParams& p);
+using core::validate;
 
 /// xi per pixel (CV_32F); NaN where a disparity is invalid or q leaves the image (d1 is sampled
 /// bilinearly, invalid when a neighbour is). Throws core::InputError on a type or size mismatch.
