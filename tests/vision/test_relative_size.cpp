@@ -4,20 +4,12 @@
 
 #include "sg/core/error.hpp"
 #include "sg/vision/relative_size.hpp"
+#include "synthetic.hpp"
 
 namespace sg::vision {
 namespace {
 
-/// Smooth random texture, 8-bit.
-cv::Mat texture(cv::Size size, std::uint64_t seed, double blur) {
-  cv::Mat noise(size, CV_8UC1);
-  cv::RNG rng(seed);
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
-  cv::Mat out;
-  cv::GaussianBlur(noise, out, cv::Size(0, 0), blur);
-  cv::normalize(out, out, 0, 255, cv::NORM_MINMAX);
-  return out;
-}
+using test::texture;
 
 /// `image` scaled by s about `centre` (and moved so that centre lands on `to`).
 cv::Mat scaled(const cv::Mat& image, double s, cv::Point2f centre, cv::Point2f to) {

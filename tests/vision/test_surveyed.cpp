@@ -7,6 +7,7 @@
 
 #include "sg/core/error.hpp"
 #include "sg/vision/surveyed.hpp"
+#include "synthetic.hpp"
 
 namespace sg::vision {
 namespace {
@@ -101,16 +102,7 @@ TEST(ProximityLabelling, MarksNearPointsInTheEnvelopeOnly) {
   EXPECT_THROW(label_proximity(cv::Mat(), cv::Mat(), cam, e, p, danger, ttc), core::InputError);
 }
 
-/// Smooth random texture, 8-bit.
-cv::Mat texture(cv::Size size, std::uint64_t seed) {
-  cv::Mat noise(size, CV_8UC1);
-  cv::RNG rng(seed);
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
-  cv::Mat out;
-  cv::GaussianBlur(noise, out, cv::Size(0, 0), 1.5);
-  cv::normalize(out, out, 0, 255, cv::NORM_MINMAX);
-  return out;
-}
+using test::texture;
 
 TEST(SceneFlowSegLabelling, AnApproachingPatchIsDangerousAPassingOneAndTheBackgroundAreNot) {
   core::Camera cam;
@@ -120,7 +112,7 @@ TEST(SceneFlowSegLabelling, AnApproachingPatchIsDangerousAPassingOneAndTheBackgr
   cam.cy = 119.5;
   const core::Envelope e;
   const core::SceneFlowSegParams p;
-  const cv::Mat left = texture({320, 240}, 4);
+  const cv::Mat left = texture({320, 240}, 4, 1.5);
   const cv::Rect patch(130, 90, 60, 60);
   // Background 12 m away, still. The patch: from 6.0 m to 4.8 m over 0.2 s (6 m/s; one frame
   // at 30 Hz moves it by less than the disparity noise hides).
@@ -161,8 +153,8 @@ TEST(SceneFlowSegLabelling, AnApproachingPatchIsDangerousAPassingOneAndTheBackgr
 TEST(RelativeSizeLabelling, AGrowingSquareIsDangerousWithTheTtcOfItsScale) {
   // A textured square before a static background grows by 12 % over 0.33 s: TTC = 0.33 / 0.12.
   const cv::Size size(480, 360);
-  const cv::Mat background = texture(size, 5);
-  const cv::Mat object = texture({400, 400}, 9);
+  const cv::Mat background = texture(size, 5, 1.5);
+  const cv::Mat object = texture({400, 400}, 9, 1.5);
   auto frame = [&](double side) {
     cv::Mat f = background.clone();
     cv::Mat patch;
