@@ -19,6 +19,7 @@ struct BenchArgs {
   std::vector<int> tiles = {1, 2, 4};
   std::vector<std::string> resolutions = {"640x480", "1242x375"};
   std::vector<double> pace = {0.8, 1.5};
+  int capacity_runs = 3;
   int frames = 300;
   int num_disparities = 64;
   std::string matcher = "fast", cost = "sad";  // run's defaults
@@ -92,6 +93,7 @@ void bench_main(const BenchArgs& a) {
   config.tokens = a.tokens;
   config.scenario = a.scenario;
   config.pace_fractions = a.pace;
+  config.capacity_runs = a.capacity_runs;
   if (a.input.spec.any() || a.input.sbs) {
     config.open_input = [input = a.input] { return open_input(input).source; };
   }
@@ -146,6 +148,9 @@ void add_bench_command(CLI::App& app) {
                   "also pace the best configuration (lowest p99 within 5 % of the top fps) at "
                   "these fractions of its capacity (first resolution; default 0.8,1.5)")
       ->delimiter(',');
+  cmd->add_option("--capacity-runs", a->capacity_runs,
+                  "the capacity the pace refers to: the median fps of this many runs of the best "
+                  "configuration (its row and N - 1 'capacity' rows; 1..9, default 3)");
   add_source_options(*cmd, a->input);
   cmd->add_option("--csv", a->csv, "CSV output (default stereoguard-bench.csv)");
   cmd->add_option("--plot", a->plot, "draw throughput and latency to this PNG (needs gnuplot)");

@@ -1,5 +1,7 @@
 #include "sg/pipeline/bench.hpp"
 
+#include <algorithm>
+
 #include <sstream>
 
 #include "sg/core/error.hpp"
@@ -126,6 +128,8 @@ std::vector<std::string> validate(const BenchConfig& c) {
   if (c.frames < 10) out.push_back("bench.frames=" + std::to_string(c.frames) + ": must be >= 10");
   for (double f : c.pace_fractions)
     if (!(f > 0 && f <= 10)) out.push_back("bench.pace: fractions must be in (0, 10]");
+  if (c.capacity_runs < 1 || c.capacity_runs > 9)
+    out.push_back("bench.capacity_runs=" + std::to_string(c.capacity_runs) + ": must be in 1..9");
   return out;
 }
 
@@ -247,11 +251,24 @@ std::vector<BenchRow> run_bench(const BenchConfig& config,
         }
       }
       const std::size_t best = best_for_pacing(swept);
-      if (r != 0 || best == swept.size()) continue;
+      if (r != 0 || best == swept.size() || config.pace_fractions.empty()) continue;
+      options.workers = swept[best].workers;
+      options.tiles = swept[best].tiles;
+      std::vector<double> capacity{swept[best].fps};
+      for (int k = 1; k < config.capacity_runs; ++k) {
+        Measured m = run_pipeline(frames, camera, options);
+        m.row.kind = "capacity";
+        m.row.mode = core::to_string(mode);
+        m.row.resolution = size;
+        set_speedups(m.row);
+        m.row.same_detections = m.signals == baseline.signals;
+        emit(m.row);
+        capacity.push_back(m.row.fps);
+      }
+      std::nth_element(capacity.begin(), capacity.begin() + capacity.size() / 2, capacity.end());
+      const double capacity_fps = capacity[capacity.size() / 2];
       for (double fraction : config.pace_fractions) {
-        options.workers = swept[best].workers;
-        options.tiles = swept[best].tiles;
-        options.pace_fps = fraction * swept[best].fps;
+        options.pace_fps = fraction * capacity_fps;
         Measured m = run_pipeline(frames, camera, options);
         options.pace_fps = 0;
         m.row.mode = core::to_string(mode);

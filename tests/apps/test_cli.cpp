@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <optional>
+#include <algorithm>
 #include <sstream>
 #include <string>
 
@@ -326,8 +327,9 @@ TEST_F(Cli, BenchWritesOneCsvRowPerConfigurationBesideItsBaselines) {
   std::ifstream csv(dir_ / "b.csv");
   std::vector<std::string> rows;
   for (std::string line; std::getline(csv, line);) rows.push_back(line);
-  // header, baseline, opencv-mt, 4 pipeline configurations, 1 paced run
-  ASSERT_EQ(rows.size(), 8u) << r.out;
+  // header, baseline, opencv-mt, 4 pipeline configurations, 2 more capacity runs of the best
+  // one, 1 paced run
+  ASSERT_EQ(rows.size(), 10u) << r.out;
   EXPECT_EQ(rows[0].rfind("kind,mode,width,height,workers,tiles", 0), 0u);
   EXPECT_EQ(rows[1].rfind("baseline,stereo,161,121,", 0), 0u) << rows[1];
   EXPECT_EQ(rows[2].rfind("opencv-mt,stereo,161,121,", 0), 0u) << rows[2];
@@ -338,7 +340,24 @@ TEST_F(Cli, BenchWritesOneCsvRowPerConfigurationBesideItsBaselines) {
     const std::string head = rows[i].substr(0, rows[i].rfind(','));
     EXPECT_EQ(head.substr(head.rfind(',') + 1), "yes") << rows[i];
   }
-  EXPECT_EQ(rows[7].rfind("paced,stereo,161,121,", 0), 0u) << rows[7];
+  EXPECT_EQ(rows[7].rfind("capacity,stereo,161,121,", 0), 0u) << rows[7];
+  EXPECT_EQ(rows[8].rfind("capacity,stereo,161,121,", 0), 0u) << rows[8];
+  EXPECT_EQ(rows[9].rfind("paced,stereo,161,121,", 0), 0u) << rows[9];
+  // The pace is 2 x the median fps of the best configuration's three runs (its sweep row and the
+  // two capacity rows, which share its W and T).
+  auto field = [](const std::string& row, int k) {
+    std::stringstream s(row);
+    std::string f;
+    for (int i = 0; i <= k; ++i) std::getline(s, f, ',');
+    return f;
+  };
+  std::vector<double> capacity;
+  for (int i = 3; i < 9; ++i)
+    if (field(rows[i], 4) == field(rows[9], 4) && field(rows[i], 5) == field(rows[9], 5))
+      capacity.push_back(std::stod(field(rows[i], 11)));
+  ASSERT_EQ(capacity.size(), 3u);
+  std::sort(capacity.begin(), capacity.end());
+  EXPECT_NEAR(std::stod(field(rows[9], 7)), 2 * capacity[1], 1e-3 * capacity[1]);
   EXPECT_GT(fs::file_size(dir_ / "b.png"), 1000u);
   // The pipeline rows use run's default matcher (it once said fast and ran bm).
   EXPECT_NE(r.out.find("pipeline rows: matcher fast (baselines: bm)"), std::string::npos) << r.out;
@@ -347,6 +366,7 @@ TEST_F(Cli, BenchWritesOneCsvRowPerConfigurationBesideItsBaselines) {
 TEST_F(Cli, BenchRejectsBadSettings) {
   expect_user_error(run("bench --resolutions 640by480"), "640by480");
   expect_user_error(run("bench --workers 0 --frames 12"), "workers=0");
+  expect_user_error(run("bench --capacity-runs 0 --frames 12"), "capacity_runs=0");
 }
 
 }  // namespace

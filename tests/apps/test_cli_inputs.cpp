@@ -215,7 +215,7 @@ TEST_F(Inputs, BenchOnARealInputUsesItsFramesAndResolution) {
   make_folder(6);
   const Output r =
       sg("bench --left fold/left --right fold/right --calib fold/camera.yaml --modes "
-         "stereo --workers 1,2 --tiles 1 --frames 14 --pace 2 --csv b.csv");
+         "stereo --workers 1,2 --tiles 1 --frames 14 --pace 2 --capacity-runs 1 --csv b.csv");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("input fold/left + fold/right"), std::string::npos) << r.out;
   std::ifstream csv(dir_ / "b.csv");

@@ -29,6 +29,11 @@ struct BenchConfig {
   /// Also run the best configuration of each mode (first resolution, best_for_pacing) paced at
   /// these fractions of its measured capacity (empty = none).
   std::vector<double> pace_fractions = {0.8, 1.5};
+  /// The capacity those fractions refer to: the median throughput of this many runs of the best
+  /// configuration (its sweep row and capacity_runs - 1 more, rows of kind "capacity"), 1..9. One
+  /// run of 150 frames on a busy 2-core machine reads up to 20 % off (head-on, W 2 T 2: 97-112
+  /// fps in six sweeps), and a pace set from a run that read high is no longer 80 % of capacity.
+  int capacity_runs = 3;
   /// When set, the frames come from this input instead of the scenario: read once into memory (up
   /// to `frames`, played forwards then backwards when shorter), at the input's own resolution and
   /// camera; `scenario` and `resolutions` are then ignored.
