@@ -42,16 +42,18 @@ Mode parse_mode(const std::string& text) {
 
 Needs needs(Mode m) {
   switch (m) {
-    case Mode::kStereoFlow:
-    case Mode::kSceneFlowSeg: return {true, true};
-    case Mode::kMotionParallax: return {false, true};
-    case Mode::kRelativeSize: return {false, false};
+    case Mode::kStereoFlow: return {true, true, false};
+    case Mode::kSceneFlowSeg: return {true, true, true};
+    case Mode::kMotionParallax: return {false, true, false};
+    case Mode::kRelativeSize: return {false, false, true};
     case Mode::kStereo:
     case Mode::kElevationMap:
-    case Mode::kLongSeq: return {true, false};
+    case Mode::kLongSeq: return {true, false, false};
   }
   return {};
 }
+
+bool is_surveyed(Mode m) { return m != Mode::kStereo && m != Mode::kStereoFlow; }
 
 void select_detector(DetectorParams& p, Mode m) {
   p.mode = m;

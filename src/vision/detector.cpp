@@ -60,7 +60,7 @@ void LabelJob::run_surveyed() {
 
 void LabelJob::run(cv::Range rows) {
   const core::DetectorParams& p = *params_;
-  if (mode_ != core::Mode::kStereo && mode_ != core::Mode::kStereoFlow) {
+  if (core::is_surveyed(mode_)) {
     run_surveyed();
     return;
   }
@@ -87,7 +87,7 @@ Detector::Detector(const core::DetectorParams& params, const core::Camera& camer
       tracker_(params.signal, params.envelope.z_contact_m,
                camera.focal_px * camera.baseline_m / std::max(1, params.bm.num_disparities - 1)),
       severity_(params.signal) {
-  if (params_.mode == core::Mode::kStereo || params_.mode == core::Mode::kStereoFlow) {
+  if (!core::is_surveyed(params_.mode)) {
     const std::vector<int>& gaps =
         params_.mode == core::Mode::kStereoFlow ? params_.scene_flow.gaps : params_.stereo.gaps;
     if (!gaps.empty()) max_gap_ = std::max(1, *std::max_element(gaps.begin(), gaps.end()));
@@ -98,8 +98,8 @@ Detector::Detector(const core::DetectorParams& params, const core::Camera& camer
 
 LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
   const core::Needs need = core::needs(params_.mode);
-  const bool with_left = !need.disparity || params_.mode == core::Mode::kRelativeSize ||
-                         params_.mode == core::Mode::kSceneFlowSeg;
+  // Without a disparity the left image gives the size of the maps.
+  const bool with_left = need.left_image || !need.disparity;
   if (with_left && (maps.left.empty() || maps.left.type() != CV_8UC1))
     throw core::InputError("detector: " + std::string(core::to_string(params_.mode)) +
                            " needs the left image, a non-empty CV_8U image");
@@ -166,7 +166,7 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
     // Over the first frames of a chain the disparity error dominates the fit (startup_doubt_px).
     job.short_chain_ = params_.scene_flow.fit_velocity && reached < max_gap_;
     allocate_stereo_flow_outputs(disp.size(), job.danger_, job.ttc_, job.velocity_);
-  } else if (params_.mode != core::Mode::kStereo) {
+  } else if (core::is_surveyed(params_.mode)) {
     prepare_surveyed(frame, maps, job);
   } else {
     for (int k : params_.stereo.gaps)

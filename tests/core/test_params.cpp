@@ -69,6 +69,12 @@ TEST(Params, DetectorsByNameWithWhatTheyNeed) {
   EXPECT_TRUE(needs(Mode::kSceneFlowSeg).disparity && needs(Mode::kSceneFlowSeg).flow);
   EXPECT_TRUE(needs(Mode::kElevationMap).disparity && !needs(Mode::kElevationMap).flow);
   EXPECT_TRUE(needs(Mode::kStereoFlow).flow && !needs(Mode::kStereo).flow);
+  EXPECT_TRUE(needs(Mode::kRelativeSize).left_image && needs(Mode::kSceneFlowSeg).left_image);
+  EXPECT_FALSE(needs(Mode::kStereoFlow).left_image || needs(Mode::kElevationMap).left_image);
+  int surveyed = 0;
+  for (const Mode m : all_modes()) surveyed += is_surveyed(m);
+  EXPECT_EQ(surveyed, 5);
+  EXPECT_FALSE(is_surveyed(Mode::kStereo) || is_surveyed(Mode::kStereoFlow));
   // The longseq detector brings its matcher; another one is an error naming the field.
   DetectorParams p;
   select_detector(p, Mode::kLongSeq);

@@ -35,8 +35,13 @@ std::vector<Mode> all_modes();
 struct Needs {
   bool disparity = true;  ///< stereo matching (SM)
   bool flow = false;      ///< the backward flow to the previous frame's left image (OF)
+  /// The labelling reads the left image itself (relative-size: this frame's and an earlier one's;
+  /// sceneflow-seg: this frame's, for the cut's contrast weights).
+  bool left_image = false;
 };
 Needs needs(Mode m);
+/// One of the five detectors the thesis surveys (vision/surveyed.hpp), not Stereo or Stereo-Flow.
+bool is_surveyed(Mode m);
 
 /// Stereo matcher (DESIGN 2.1): OpenCV StereoBM, OpenCV StereoSGBM, our own SIMD matcher, or
 /// LongSeq (thesis 3.2.3, vision/longseq.hpp: the longest run of good matches over one row).
