@@ -176,6 +176,10 @@ pipeline::RunOptions make_run_options(const DetectorOptions& o,
   if (o.matcher) run.params.bm.matcher = core::parse_matcher(*o.matcher);
   if (o.cost) run.params.bm.cost = core::parse_match_cost(*o.cost);
   if (o.gaps) {
+    if (core::is_surveyed(run.params.mode))
+      throw core::InputError(std::string("gaps: the ") + core::to_string(run.params.mode) +
+                             " detector compares no frame gaps (stereo and stereo-flow do; "
+                             "relative-size has relative_size.gap_frames)");
     if (run.params.mode == core::Mode::kStereoFlow)
       run.params.scene_flow.gaps = *o.gaps;
     else

@@ -204,6 +204,9 @@ TEST_F(Cli, EveryDetectorRunsAndNamesItsBadParameters) {
                     "detector=optic-flow: must be one of");
   expect_user_error(run("run --scenario '" + scenario + "' --detector longseq --matcher fast"),
                     "stereo.matcher=fast: must be longseq with the longseq detector");
+  // --gaps means nothing to them: an error, not a flag silently ignored.
+  expect_user_error(run("run --scenario '" + scenario + "' --detector motion-parallax --gaps 1,4"),
+                    "gaps: the motion-parallax detector compares no frame gaps");
 }
 
 TEST_F(Cli, RepeatedRunsGiveByteIdenticalEvents) {
