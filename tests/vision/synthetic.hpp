@@ -31,6 +31,18 @@ inline cv::Mat texture(cv::Size size, uint64_t seed, double sigma = 1.0) {
   return smooth;
 }
 
+/// Frames of a textured square in front of a static textured background, 480 x 360: the square,
+/// `side` px wide, centred at (240, 180) (the relative-size tests grow it between frames).
+inline cv::Mat square_before_background(double side) {
+  static const cv::Mat background = texture({480, 360}, 5, 1.5);
+  static const cv::Mat object = texture({400, 400}, 9, 1.5);
+  cv::Mat f = background.clone();
+  cv::Mat patch;
+  cv::resize(object, patch, cv::Size(cvRound(side), cvRound(side)), 0, 0, cv::INTER_AREA);
+  patch.copyTo(f(cv::Rect(240 - patch.cols / 2, 180 - patch.rows / 2, patch.cols, patch.rows)));
+  return f;
+}
+
 /// A rectified pair where every left pixel (x, y) matches right pixel (x - d, y): the right image
 /// is the left texture sampled at x + d (bilinear for fractional d).
 struct StereoPair {

@@ -57,17 +57,7 @@ TEST(RelativeSize, CoarseToFineFindsTheScaleOfTheFullSearch) {
 
 TEST(RelativeSize, AnExpandingTexturedSquareIsAClusterTheStaticBackgroundIsNot) {
   // A static background and, in front of it, a textured square that grows by 12 %.
-  const cv::Size size(480, 360);
-  const cv::Mat background = texture(size, 5, 1.5);
-  const cv::Mat object = texture({400, 400}, 9, 1.5);
-  auto frame = [&](double side) {
-    cv::Mat f = background.clone();
-    cv::Mat patch;
-    cv::resize(object, patch, cv::Size(cvRound(side), cvRound(side)), 0, 0, cv::INTER_AREA);
-    const cv::Rect at(240 - patch.cols / 2, 180 - patch.rows / 2, patch.cols, patch.rows);
-    patch.copyTo(f(at));
-    return f;
-  };
+  const auto frame = test::square_before_background;
   const cv::Mat prev = frame(140.0), cur = frame(140.0 * 1.12);
   const std::vector<ExpandingFeature> found = expanding_features(prev, cur, RelativeSizeParams{});
   const cv::Rect square(240 - 79, 180 - 79, 158, 158);

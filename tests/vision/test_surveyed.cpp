@@ -152,16 +152,7 @@ TEST(SceneFlowSegLabelling, AnApproachingPatchIsDangerousAPassingOneAndTheBackgr
 
 TEST(RelativeSizeLabelling, AGrowingSquareIsDangerousWithTheTtcOfItsScale) {
   // A textured square before a static background grows by 12 % over 0.33 s: TTC = 0.33 / 0.12.
-  const cv::Size size(480, 360);
-  const cv::Mat background = texture(size, 5, 1.5);
-  const cv::Mat object = texture({400, 400}, 9, 1.5);
-  auto frame = [&](double side) {
-    cv::Mat f = background.clone();
-    cv::Mat patch;
-    cv::resize(object, patch, cv::Size(cvRound(side), cvRound(side)), 0, 0, cv::INTER_AREA);
-    patch.copyTo(f(cv::Rect(240 - patch.cols / 2, 180 - patch.rows / 2, patch.cols, patch.rows)));
-    return f;
-  };
+  const auto frame = test::square_before_background;
   const double span = 10 * kDt;
   const core::RelativeSizeParams p;
   cv::Mat danger, ttc;
