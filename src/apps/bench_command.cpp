@@ -31,6 +31,10 @@ struct BenchArgs {
   InputOptions input;  ///< a real input instead of the scenario (--left/--right, --euroc, ...)
 };
 
+/// A spread of the capacity runs above this is the machine, not the pipeline (run to run, the
+/// same configuration moves by a few per cent on a quiet machine).
+constexpr double kNoisySpread = 0.10;
+
 void print_row(const pipeline::BenchRow& r) {
   std::cout << std::left << std::setw(10) << r.kind << std::setw(16) << r.mode << std::right
             << std::setw(5) << r.resolution.width << "x" << std::left << std::setw(5)
@@ -40,6 +44,18 @@ void print_row(const pipeline::BenchRow& r) {
             << std::setw(8) << r.speedup << std::setw(8) << r.speedup_1t << std::setprecision(1)
             << std::setw(8) << r.latency_p50_ms << std::setw(8) << r.latency_p99_ms << std::setw(7)
             << r.dropped << "  " << pipeline::same_detections_text(r) << std::endl;
+}
+
+/// What the paced rows below refer to, and whether to trust it (BenchRow::capacity_spread).
+void print_capacity(const pipeline::BenchRow& r) {
+  std::cout << std::fixed << std::setprecision(1) << "(paced rows: fractions of " << r.capacity_fps
+            << " fps, the median of " << r.capacity_runs << " runs of W " << r.workers << " T "
+            << r.tiles << ", spread " << 100.0 * r.capacity_spread << " %";
+  if (r.capacity_spread > kNoisySpread)
+    std::cout << "; over " << 100.0 * kNoisySpread
+              << " %: the machine's speed changed between runs, so the pace may not be the "
+                 "fraction asked for; run again";
+  std::cout << ")" << std::endl;
 }
 
 void write_plot(const std::string& csv, const std::string& png,
@@ -111,7 +127,12 @@ void bench_main(const BenchArgs& a) {
                "     p50     p99   drop  same\n"
             << "(vs-mt: speedup against the plain loop with OpenCV's threads, the default a user "
                "gets; vs-1t: against the same loop on one thread)\n";
+  std::string capacity_told;  // the mode whose capacity line was printed
   pipeline::run_bench(config, [&](const pipeline::BenchRow& row) {
+    if (row.kind == "paced" && row.mode != capacity_told) {
+      print_capacity(row);
+      capacity_told = row.mode;
+    }
     print_row(row);
     csv << pipeline::to_csv(row) << "\n" << std::flush;
   });

@@ -265,8 +265,9 @@ std::vector<BenchRow> run_bench(const BenchConfig& config,
         emit(m.row);
         capacity.push_back(m.row.fps);
       }
-      std::nth_element(capacity.begin(), capacity.begin() + capacity.size() / 2, capacity.end());
+      std::sort(capacity.begin(), capacity.end());
       const double capacity_fps = capacity[capacity.size() / 2];
+      const double spread = (capacity.back() - capacity.front()) / capacity_fps;
       for (double fraction : config.pace_fractions) {
         options.pace_fps = fraction * capacity_fps;
         Measured m = run_pipeline(frames, camera, options);
@@ -275,6 +276,9 @@ std::vector<BenchRow> run_bench(const BenchConfig& config,
         m.row.resolution = size;
         set_speedups(m.row);
         m.row.same_detections = m.row.dropped == 0 ? m.signals == baseline.signals : false;
+        m.row.capacity_fps = capacity_fps;
+        m.row.capacity_spread = spread;
+        m.row.capacity_runs = static_cast<int>(capacity.size());
         emit(m.row);
       }
     }

@@ -361,6 +361,19 @@ TEST_F(Cli, BenchWritesOneCsvRowPerConfigurationBesideItsBaselines) {
   ASSERT_EQ(capacity.size(), 3u);
   std::sort(capacity.begin(), capacity.end());
   EXPECT_NEAR(std::stod(field(rows[9], 7)), 2 * capacity[1], 1e-3 * capacity[1]);
+  // The text names that capacity, its runs and their spread before the paced row.
+  const std::string told = "(paced rows: fractions of ";
+  const size_t at = r.out.find(told);
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_LT(at, r.out.find("\npaced ")) << r.out;
+  EXPECT_NEAR(std::stod(r.out.substr(at + told.size())), capacity[1], 0.051) << r.out;
+  const std::string runs = " fps, the median of 3 runs of W " + field(rows[9], 4) + " T " +
+                           field(rows[9], 5) + ", spread ";
+  const size_t spread = r.out.find(runs, at);
+  ASSERT_NE(spread, std::string::npos) << runs << "\n" << r.out;
+  EXPECT_NEAR(std::stod(r.out.substr(spread + runs.size())),
+              100.0 * (capacity[2] - capacity[0]) / capacity[1], 0.051)
+      << r.out;
   EXPECT_GT(fs::file_size(dir_ / "b.png"), 1000u);
   // The pipeline rows use run's default matcher (it once said fast and ran bm).
   EXPECT_NE(r.out.find("pipeline rows: matcher fast (baselines: bm)"), std::string::npos) << r.out;
