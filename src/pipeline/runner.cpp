@@ -27,7 +27,8 @@ namespace {
 /// off the emitter. A failed decode throws to every caller.
 class LazyFrame {
  public:
-  explicit LazyFrame(core::PendingFrame pending) : pending_(std::move(pending)) {
+  explicit LazyFrame(core::PendingFrame pending)
+      : pending_(std::move(pending)), load_where_read_(pending_.load_where_read) {
     header_.index = pending_.index;
     header_.time_s = pending_.time_s;
   }
@@ -47,12 +48,15 @@ class LazyFrame {
   }
   /// Index and time only, known without decoding.
   const core::StereoFrame& header() const { return header_; }
+  /// core::PendingFrame::load_where_read.
+  bool load_where_read() const { return load_where_read_; }
   /// Time the decode took, ms (0 before it ran).
   double decode_ms() const { return decode_ms_; }
 
  private:
   std::once_flag once_;
   core::PendingFrame pending_;
+  bool load_where_read_;
   core::StereoFrame header_, frame_;
   double decode_ms_ = 0.0;
 };
@@ -101,6 +105,7 @@ class Emitter {
     job.frame = std::make_shared<LazyFrame>(std::move(*frame));
     job.previous = previous_;
     previous_ = job.frame;
+    if (job.frame->load_where_read()) job.frame->get();  // the emitter's work, not the farm's
     busy_ms_ += par::elapsed_ms(begin);
     if (pace_fps_ > 0) {
       job.acquired = capture_time(emitted_ + dropped_);
@@ -345,7 +350,7 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
         s.first_alarm_time_s = detection.time_s;
       }
     }
-    s.busy_decode_ms += job.frame->decode_ms();
+    if (!job.frame->load_where_read()) s.busy_decode_ms += job.frame->decode_ms();
     s.busy_sm_ms += job.sm_ms;
     s.busy_of_ms += job.of_ms;
     s.busy_label_ms += std::accumulate(job.label_ms.begin(), job.label_ms.end(), 0.0);

@@ -493,6 +493,18 @@ std::optional<core::StereoFrame> ScenarioSource::next() {
   return last_.frame;
 }
 
+std::optional<core::PendingFrame> ScenarioSource::next_pending() {
+  if (next_index_ >= renderer_.scenario().frames) return std::nullopt;
+  const int index = next_index_++;
+  core::PendingFrame pending;
+  pending.index = index;
+  pending.time_s = index / renderer_.scenario().camera.fps;  // as render() stamps it
+  const Renderer* renderer = &renderer_;
+  pending.load = [renderer, index] { return renderer->render(index).frame; };
+  pending.load_where_read = true;
+  return pending;
+}
+
 const core::Camera& ScenarioSource::camera() const { return renderer_.scenario().camera; }
 
 int ScenarioSource::size() const { return renderer_.scenario().frames; }

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 
 #include "sg/core/error.hpp"
@@ -292,6 +293,45 @@ TEST(Pipeline, PacedFasterThanPossibleDropsAndCountsFrames) {
   EXPECT_GT(s.dropped, 0);
   EXPECT_EQ(s.frames + s.dropped, 36);
   EXPECT_GT(s.deadline_misses, 0);
+}
+
+/// Pending frames of a clip that count their loads; `where_read` sets load_where_read.
+class CountingSource : public core::FrameSource {
+ public:
+  CountingSource(const Clip& clip, bool where_read) : clip_(clip), where_read_(where_read) {}
+  std::optional<core::StereoFrame> next() override { throw std::logic_error("next_pending only"); }
+  std::optional<core::PendingFrame> next_pending() override {
+    if (next_ == static_cast<int>(clip_.frames.size())) return std::nullopt;
+    const core::StereoFrame& frame = clip_.frames[static_cast<size_t>(next_++)];
+    core::PendingFrame p{frame.index, frame.time_s, [this, &frame] {
+                           loads_.fetch_add(1);
+                           return frame;
+                         }};
+    p.load_where_read = where_read_;
+    return p;
+  }
+  const core::Camera& camera() const override { return clip_.camera; }
+  int loads() const { return loads_.load(); }
+
+ private:
+  const Clip& clip_;
+  bool where_read_;
+  int next_ = 0;
+  std::atomic<int> loads_{0};
+};
+
+TEST(Pipeline, PacedRunLoadsTheFramesItKeepsOnlyWhereverTheyLoad) {
+  for (bool where_read : {false, true}) {
+    CountingSource source(head_on(), where_read);
+    RunOptions o;
+    o.pace_fps = 100000;
+    o.workers = 2;
+    o.tiles = 2;
+    const RunSummary s = run(source, o, [](const auto&, const auto&) {});
+    EXPECT_GT(s.dropped, 0) << where_read;
+    EXPECT_EQ(s.frames + s.dropped, 36) << where_read;
+    EXPECT_EQ(source.loads(), s.frames) << where_read;
+  }
 }
 
 TEST(Pipeline, FileInputNeverDrops) {

@@ -316,6 +316,30 @@ TEST(ScenarioSource, StreamsEveryFrameWithItsTruth) {
   EXPECT_FALSE(source.next().has_value());
 }
 
+TEST(ScenarioSource, PendingFramesRenderWhenLoadedAsNextRendersThem) {
+  Scenario s = small("head-on");
+  s.frames = 4;
+  ScenarioSource eager(s), lazy(s);
+  std::vector<core::PendingFrame> pending;
+  while (auto p = lazy.next_pending()) pending.push_back(std::move(*p));
+  ASSERT_EQ(pending.size(), 4u);
+  // Loaded out of order (a dropped frame is never loaded): each frame depends on its index only.
+  std::vector<core::StereoFrame> loaded(pending.size());
+  for (size_t i : {2u, 0u, 3u}) loaded[i] = pending[i].load();
+  for (size_t i = 0; i < pending.size(); ++i) {
+    const auto frame = eager.next();
+    ASSERT_TRUE(frame.has_value());
+    EXPECT_TRUE(pending[i].load_where_read);
+    EXPECT_EQ(pending[i].index, frame->index);
+    EXPECT_EQ(pending[i].time_s, frame->time_s);
+    if (i == 1) continue;
+    EXPECT_EQ(loaded[i].index, frame->index);
+    EXPECT_EQ(loaded[i].time_s, frame->time_s);
+    EXPECT_EQ(cv::norm(loaded[i].left, frame->left, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(loaded[i].right, frame->right, cv::NORM_INF), 0.0);
+  }
+}
+
 /// GT alarm of every `step`-th frame of a built-in at full resolution, plus its last frame
 /// (truth() only casts rays, no shading).
 std::vector<std::pair<int, bool>> alarms(const std::string& name, int step) {

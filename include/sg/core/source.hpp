@@ -16,6 +16,9 @@ struct PendingFrame {
   int index = 0;        ///< 0-based frame number in the stream
   double time_s = 0.0;  ///< stream time of acquisition, s
   std::function<StereoFrame()> load;
+  /// True when `load` runs in parallel itself (a renderer's rows): the emitter loads a frame it
+  /// keeps at once, where one worker of the farm would run it alone, and never loads one it drops.
+  bool load_where_read = false;
 };
 
 /// A stream of stereo frames (a folder, a video, a simulated scenario, a camera).

@@ -73,7 +73,8 @@ struct RunSummary {
   double latency_p50_ms = 0.0, latency_p95_ms = 0.0, latency_p99_ms = 0.0, latency_max_ms = 0.0;
   double latency_mean_ms = 0.0;
   /// Busy time per stage summed over the run, ms (wall time inside the stage): emitter (read and
-  /// stamp; decoding runs on the farm), decode (imread, gray conversion: farm), stereo matching,
+  /// stamp; decoding runs on the farm, a scenario renders here: core::PendingFrame::
+  /// load_where_read), decode (imread, gray conversion: farm), stereo matching,
   /// optical flow, labelling (per-pixel danger, farm tasks after the relay), obstacles (mask
   /// cleaning, connected components, obstacle statistics: the last labelling task,
   /// LabelJob::conclude), collector (tracking, signals, sinks).

@@ -56,6 +56,10 @@ class ScenarioSource : public core::FrameSource {
  public:
   explicit ScenarioSource(Scenario scenario);
   std::optional<core::StereoFrame> next() override;
+  /// The frame's index and time stamp now, its rendering in PendingFrame::load (load_where_read:
+  /// the rendering is parallel), so that a paced run skips a frame it drops without rendering it.
+  /// last_truth() and last_maps() follow next() only.
+  std::optional<core::PendingFrame> next_pending() override;
   const core::Camera& camera() const override;
   int size() const override;
   /// Ground truth of the frame last returned by next().
