@@ -27,8 +27,7 @@ namespace {
 /// off the emitter. A failed decode throws to every caller.
 class LazyFrame {
  public:
-  explicit LazyFrame(core::PendingFrame pending)
-      : pending_(std::move(pending)), load_where_read_(pending_.load_where_read) {
+  explicit LazyFrame(core::PendingFrame pending) : pending_(std::move(pending)) {
     header_.index = pending_.index;
     header_.time_s = pending_.time_s;
   }
@@ -49,14 +48,13 @@ class LazyFrame {
   /// Index and time only, known without decoding.
   const core::StereoFrame& header() const { return header_; }
   /// core::PendingFrame::load_where_read.
-  bool load_where_read() const { return load_where_read_; }
+  bool load_where_read() const { return pending_.load_where_read; }  // get() clears only load
   /// Time the decode took, ms (0 before it ran).
   double decode_ms() const { return decode_ms_; }
 
  private:
   std::once_flag once_;
   core::PendingFrame pending_;
-  bool load_where_read_;
   core::StereoFrame header_, frame_;
   double decode_ms_ = 0.0;
 };
