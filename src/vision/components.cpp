@@ -1,43 +1,15 @@
 #include "sg/vision/components.hpp"
 
 #include <cstdint>
-#include <cstring>
 
 #include "sg/core/error.hpp"
+#include "mask_scan.hpp"
 #include "union_find.hpp"
 
 namespace sg::vision {
-namespace {
 
-constexpr std::uint64_t kLowBits = 0x0101010101010101ULL;
-constexpr std::uint64_t kHighBits = 0x8080808080808080ULL;
-
-std::uint64_t load8(const std::uint8_t* p) {
-  std::uint64_t v = 0;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
-/// The first pixel from x on with m[x] != 0, or cols; eight clear bytes at a time.
-int next_set(const std::uint8_t* m, int x, int cols) {
-  while (x + 8 <= cols && load8(m + x) == 0) x += 8;
-  while (x < cols && m[x] == 0) ++x;
-  return x;
-}
-
-/// The first pixel from x on with m[x] == 0, or cols; eight set bytes at a time (no zero byte in v:
-/// (v - 0x01..01) & ~v & 0x80..80 is 0).
-int next_clear(const std::uint8_t* m, int x, int cols) {
-  while (x + 8 <= cols) {
-    const std::uint64_t v = load8(m + x);
-    if (((v - kLowBits) & ~v & kHighBits) != 0) break;
-    x += 8;
-  }
-  while (x < cols && m[x] != 0) ++x;
-  return x;
-}
-
-}  // namespace
+using detail::next_clear;
+using detail::next_set;
 
 int connected_runs(const cv::Mat& mask, std::vector<ComponentRun>& runs,
                    std::vector<ComponentStats>& stats) {

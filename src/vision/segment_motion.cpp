@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <vector>
@@ -9,12 +10,14 @@
 #include "sg/core/error.hpp"
 #include "sg/vision/scene_flow.hpp"
 #include "sg/vision/surface_test.hpp"
+#include "mask_scan.hpp"
 #include "union_find.hpp"
 
 namespace sg::vision {
 namespace {
 
 using detail::find_root;
+using detail::next_set;
 using detail::unite_roots;
 
 bool finite(const cv::Vec3f& v) {
@@ -115,55 +118,69 @@ int label_surfaces(const cv::Mat& disp, const cv::Mat& member, float step,
   check_surface_inputs(disp, member);
   const int w = disp.cols, h = disp.rows;
   // The nodes are segments: a row's runs of members whose left neighbours are continuous, so
-  // that the union-find holds thousands of nodes, not every pixel, and a pixel costs its
-  // comparisons only. Segments are made in raster order, as the reference meets pixels.
+  // that the union-find holds thousands of nodes, not every pixel. Segments are made in raster
+  // order, as the reference meets pixels. The partition does not depend on the order of the
+  // unions, so a row is done in three passes: its segments, their joins to the row above (one
+  // union per pair of segments that touch: the first continuous pixel pair found is enough), and
+  // the bridges, which must see every pixel.
   struct Segment {
     int y, x0, x1;  ///< row, first and one past the last column
   };
   std::vector<Segment> segments;
   std::vector<int> parent;
   std::vector<int> above(static_cast<size_t>(w), -1), here(static_cast<size_t>(w), -1);
-  auto unite = [&parent](int a, int b) { unite_roots(parent, a, b); };
-  // The segment that the current one was last joined to: along a segment its pixels meet the
-  // same neighbouring segments over and over, and only the first meeting needs the union-find.
-  int joined = -1;
-  auto join = [&unite, &joined](int seg, int other) {
-    if (other == joined) return;
-    unite(seg, other);
-    joined = other;
-  };
   // Per column, as in the reference, its few most recent runs (bridge_column), naming segments.
   std::vector<Run> runs(bridge_rows_per_px > 0.0 ? static_cast<size_t>(w) * kRuns : 0);
   for (int y = 0; y < h; ++y) {
     const float* d = disp.ptr<float>(y);
     const float* du = y > 0 ? disp.ptr<float>(y - 1) : nullptr;
     const std::uint8_t* m = member.ptr<std::uint8_t>(y);
-    const std::uint8_t* mu = y > 0 ? member.ptr<std::uint8_t>(y - 1) : nullptr;
-    for (int x = 0; x < w; ++x) {
-      if (!m[x]) {
-        here[static_cast<size_t>(x)] = -1;
-        continue;
-      }
-      int seg = x > 0 ? here[static_cast<size_t>(x - 1)] : -1;
-      if (seg < 0 || std::abs(d[x - 1] - d[x]) > step) {
-        seg = static_cast<int>(segments.size());
-        segments.push_back({y, x, x + 1});
-        parent.push_back(seg);
-        joined = seg;
-      } else {
-        segments[static_cast<size_t>(seg)].x1 = x + 1;
-      }
-      here[static_cast<size_t>(x)] = seg;
-      if (mu) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int xx = x + dx;
-          if (xx < 0 || xx >= w || !mu[xx] || std::abs(du[xx] - d[x]) > step) continue;
-          join(seg, above[static_cast<size_t>(xx)]);
+    const size_t first = segments.size();
+    std::fill(here.begin(), here.end(), -1);
+    int* h_row = here.data();
+    for (int x = next_set(m, 0, w); x < w; x = next_set(m, x, w)) {
+      const int seg = static_cast<int>(segments.size());
+      const int x0 = x;
+      h_row[x++] = seg;
+      while (x < w && m[x] && std::abs(d[x - 1] - d[x]) <= step) h_row[x++] = seg;
+      segments.push_back({y, x0, x});
+      parent.push_back(seg);
+    }
+    for (size_t s = first; du && s < segments.size(); ++s) {
+      // Above neighbours of [x0, x1) lie in [x0 - 1, x1]; walk them by stretches of one segment.
+      const Segment g = segments[s];
+      const int seg = static_cast<int>(s);
+      const int end = std::min(w - 1, g.x1);
+      for (int xx = std::max(0, g.x0 - 1); xx <= end;) {
+        const int a = above[static_cast<size_t>(xx)];
+        if (a < 0) {
+          ++xx;
+          continue;
         }
+        bool touch = false;
+        for (; xx <= end && above[static_cast<size_t>(xx)] == a; ++xx) {
+          if (touch) continue;
+          const int lo = std::max(g.x0, xx - 1), hi = std::min(g.x1 - 1, xx + 1);
+          for (int x = lo; x <= hi && !touch; ++x) touch = std::abs(du[xx] - d[x]) <= step;
+        }
+        if (touch) unite_roots(parent, seg, a);
       }
-      if (runs.empty()) continue;
-      bridge_column(&runs[static_cast<size_t>(x) * kRuns], y, d[x], bridge_rows_per_px * d[x],
-                    step, seg, join);
+    }
+    if (!runs.empty()) {
+      for (size_t s = first; s < segments.size(); ++s) {
+        // Along a segment its pixels meet the same runs' segments over and over: only the first
+        // meeting needs the union-find.
+        const int seg = static_cast<int>(s);
+        int joined = seg;
+        auto join = [&parent, &joined](int node, int other) {
+          if (other == joined) return;
+          unite_roots(parent, node, other);
+          joined = other;
+        };
+        for (int x = segments[s].x0; x < segments[s].x1; ++x)
+          bridge_column(&runs[static_cast<size_t>(x) * kRuns], y, d[x], bridge_rows_per_px * d[x],
+                        step, seg, join);
+      }
     }
     std::swap(above, here);
   }
@@ -183,17 +200,19 @@ int label_surfaces(const cv::Mat& disp, const cv::Mat& member, float step,
   return count;
 }
 
-float interquartile_mean(std::vector<float>& v) {
-  const size_t quarter = v.size() / 4;
-  const auto low = v.begin() + static_cast<std::ptrdiff_t>(quarter);
-  const auto high = v.end() - static_cast<std::ptrdiff_t>(quarter);
+float interquartile_mean(std::vector<float>& v) { return interquartile_mean(v.data(), v.size()); }
+
+float interquartile_mean(float* v, size_t n) {
+  const size_t quarter = n / 4;
+  float* const low = v + quarter;
+  float* const high = v + (n - quarter);
   // Ranks below `quarter` go left of `low`; then, among the rest, ranks from n - quarter go right
   // of `high`: [low, high) holds exactly the middle ranks, in some order.
-  std::nth_element(v.begin(), low, v.end());
-  if (quarter > 0) std::nth_element(low, high, v.end());
+  std::nth_element(v, low, v + n);
+  if (quarter > 0) std::nth_element(low, high, v + n);
   // In double, so that the order (not the sort's) changes the float result by a rounding at most.
   double sum = 0.0;
-  for (auto it = low; it != high; ++it) sum += *it;
+  for (const float* it = low; it != high; ++it) sum += *it;
   return static_cast<float>(sum / static_cast<double>(high - low));
 }
 
@@ -232,24 +251,36 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
   // A gap of bridge_m at depth Z = f B / d spans bridge_m f / Z = (bridge_m / B) d rows.
   const int count = label_surfaces(disp, member, static_cast<float>(p.edge_step_px),
                                    p.surface_bridge_m / cam.baseline_m, labels);
-  // Velocity components per surface, then their interquartile means.
-  std::vector<std::vector<float>> vx(static_cast<size_t>(count)), vy(vx.size()), vz(vx.size());
-  for (int y = 0; y < disp.rows; ++y) {
-    const int* l = labels.ptr<int>(y);
-    const cv::Vec3f* v = velocity.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < disp.cols; ++x) {
-      if (l[x] == 0 || !finite(v[x])) continue;
-      const auto s = static_cast<size_t>(l[x]);
-      vx[s].push_back(v[x][0]);
-      vy[s].push_back(v[x][1]);
-      vz[s].push_back(v[x][2]);
+  // Velocity components per surface, in raster order (each surface's values one after another
+  // in three flat arrays: a count, then a fill), then their interquartile means.
+  const auto surfaces = static_cast<size_t>(count);
+  std::vector<size_t> start(surfaces + 1, 0);
+  auto for_known = [&](auto&& f) {
+    for (int y = 0; y < disp.rows; ++y) {
+      const int* l = labels.ptr<int>(y);
+      const cv::Vec3f* v = velocity.ptr<cv::Vec3f>(y);
+      for (int x = 0; x < disp.cols; ++x)
+        if (l[x] != 0 && finite(v[x])) f(static_cast<size_t>(l[x]), v[x]);
     }
+  };
+  for_known([&start](size_t s, const cv::Vec3f&) { ++start[s + 1]; });
+  for (size_t s = 0; s < surfaces; ++s) start[s + 1] += start[s];
+  std::vector<float> vx(start[surfaces]), vy(vx.size()), vz(vx.size());
+  std::vector<size_t> next(start.begin(), start.end() - 1);
+  for_known([&](size_t s, const cv::Vec3f& v) {
+    const size_t i = next[s]++;
+    vx[i] = v[0];
+    vy[i] = v[1];
+    vz[i] = v[2];
+  });
+  std::vector<cv::Vec3f> pooled(surfaces, cv::Vec3f(kNaN, kNaN, kNaN));
+  for (size_t s = 1; s < surfaces; ++s) {
+    const size_t n = start[s + 1] - start[s];
+    if (n > 0)
+      pooled[s] = cv::Vec3f(interquartile_mean(&vx[start[s]], n),
+                            interquartile_mean(&vy[start[s]], n),
+                            interquartile_mean(&vz[start[s]], n));
   }
-  std::vector<cv::Vec3f> pooled(static_cast<size_t>(count), cv::Vec3f(kNaN, kNaN, kNaN));
-  for (size_t s = 1; s < pooled.size(); ++s)
-    if (!vx[s].empty())
-      pooled[s] = cv::Vec3f(interquartile_mean(vx[s]), interquartile_mean(vy[s]),
-                            interquartile_mean(vz[s]));
 
   // Per surface: whether its pixels are tested at all. Faster than max_speed_mps is a mismatch,
   // and V keep can reach the envelope's approach speed v_min_mps > 0 only if V does
@@ -273,6 +304,13 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
       const auto s = static_cast<size_t>(l[x]);
       int end = x + 1;
       while (end < disp.cols && l[end] == l[x]) ++end;
+      if (s == 0) {  // no surface: safe, no velocity
+        std::fill(t + x, t + end, kNaN);
+        std::fill(v + x, v + end, cv::Vec3f(kNaN, kNaN, kNaN));
+        std::fill(out + x, out + end, std::uint8_t{0});
+        x = end;
+        continue;
+      }
       if (tested[s])
         test_surface_run(test, cv::Vec3d(pooled[s]), y, x, end, d, t);
       else

@@ -21,9 +21,11 @@ namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 /// Whole vectors of test_surface_run from x0; returns where the scalar tail starts. The
-/// operations are those of test_surface_run_reference, lane by lane, in the same order.
-int TestRunVectors(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
-                   const float* d, float* ttc) {
+/// operations are those of test_surface_run_reference, lane by lane, in the same order. Without
+/// doubt (kDoubt false) keep is 1 exactly, as in the reference, and its divisions are left out.
+template <bool kDoubt>
+int TestRunVectorsT(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
+                    const float* d, float* ttc) {
   const hn::ScalableTag<double> dd;
   const hn::Rebind<float, decltype(dd)> df;
   const int n = static_cast<int>(hn::Lanes(dd));
@@ -36,13 +38,12 @@ int TestRunVectors(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int 
   const auto y_off = hn::Set(dd, y - k.cy);
   const auto vz_span = hn::Set(dd, V[2] * k.span_s);
   const auto min_delta = hn::Set(dd, k.min_delta_d_px);
-  // Without doubt, sigma_V = ((Z 0) / d) / 1 = 0 and keep = 1 - 0 / 1 = 1 exactly, as in the
-  // reference, and no branch: GCC 12 if-converted one here into AVX-512 masked operations whose
-  // mask it set from the bool (0 or 1), so that only lane 0 took the doubt.
-  const bool doubt = k.sqrt_time_spread > 0.0 && V[2] < 0.0;
-  const auto doubt_px = hn::Set(dd, doubt ? k.startup_doubt_px : 0.0);
-  const auto sqrt_spread = hn::Set(dd, doubt ? k.sqrt_time_spread : 1.0);
-  const auto approach = hn::Set(dd, doubt ? -V[2] : 1.0);
+  // The doubt is a template parameter, not a branch in the loop: GCC 12 if-converted such a
+  // branch into AVX-512 masked operations whose mask it set from the bool (0 or 1), so that only
+  // lane 0 took the doubt.
+  const auto doubt_px = hn::Set(dd, k.startup_doubt_px);
+  const auto sqrt_spread = hn::Set(dd, k.sqrt_time_spread);
+  const auto approach = hn::Set(dd, -V[2]);
   const auto vx = hn::Set(dd, V[0]), vy = hn::Set(dd, V[1]), vz = hn::Set(dd, V[2]);
   const auto neg_v_min = hn::Set(dd, -k.v_min_mps);
   const auto z_contact = hn::Set(dd, k.envelope.z_contact_m);
@@ -57,8 +58,11 @@ int TestRunVectors(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int 
     const auto px = hn::Div(hn::Mul(hn::Sub(hn::Iota(dd, static_cast<double>(x)), cx), z), focal);
     const auto py = hn::Div(hn::Mul(y_off, z), focal);
     const auto z_before = hn::Sub(z, vz_span);
-    const auto sigma_v = hn::Div(hn::Div(hn::Mul(z, doubt_px), disp), sqrt_spread);
-    const auto keep = hn::Sub(one, hn::Div(sigma_v, approach));
+    auto keep = one;
+    if constexpr (kDoubt) {
+      const auto sigma_v = hn::Div(hn::Div(hn::Mul(z, doubt_px), disp), sqrt_spread);
+      keep = hn::Sub(one, hn::Div(sigma_v, approach));
+    }
     const auto kvz = hn::Mul(vz, keep);
     const auto t_c = hn::Div(hn::Sub(z, z_contact), hn::Neg(kvz));
     const auto ex = hn::Add(px, hn::Mul(hn::Mul(vx, keep), t_c));
@@ -78,6 +82,13 @@ int TestRunVectors(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int 
     hn::StoreU(hn::DemoteTo(df, t), df, ttc + x);
   }
   return x;
+}
+
+int TestRunVectors(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
+                   const float* d, float* ttc) {
+  const bool doubt = k.sqrt_time_spread > 0.0 && V[2] < 0.0;
+  return doubt ? TestRunVectorsT<true>(k, V, y, x0, x1, d, ttc)
+               : TestRunVectorsT<false>(k, V, y, x0, x1, d, ttc);
 }
 
 std::int64_t CurrentTarget() { return HWY_TARGET; }

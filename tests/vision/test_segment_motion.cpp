@@ -266,5 +266,38 @@ TEST(LabelSurfaces, AgreesWithThePixelByPixelReference) {
                core::InputError);
 }
 
+// label_surfaces joins a segment to the one above once for the pair, from the first continuous
+// pixel pair it finds: a ramp that meets the row above only at its far end (or its near end, or
+// only diagonally past either end) still joins it, and one that never meets it does not.
+TEST(LabelSurfaces, JoinsTheRowAboveWhereverAlongTheSegmentTheyMeet) {
+  struct Ramp {
+    const char* what;
+    float start, slope;  ///< row 1's disparity at x = 2 + i: start + slope * i, i = 0..9
+    bool joined;
+  };
+  // Row 0: columns 2..11 at 10 px; step 0.5, so a ramp of slope 0.45 stays one segment.
+  const Ramp ramps[] = {{"meets at its far end", 14.05f, -0.45f, true},
+                        {"meets at its near end", 10.0f, 0.45f, true},
+                        {"never meets", 14.05f, 0.45f, false}};
+  for (const Ramp& r : ramps) {
+    for (const int shift : {0, 1, -1}) {  // row 1 shifted: the meeting pixel pair is diagonal
+      cv::Mat disp(3, 16, CV_32F, cv::Scalar(0)), member(3, 16, CV_8U, cv::Scalar(0));
+      for (int x = 2; x < 12; ++x) {
+        disp.at<float>(0, x) = 10.0f;
+        member.at<uint8_t>(0, x) = 255;
+        const int i = x - 2, xr = x + shift;
+        disp.at<float>(1, xr) = r.start + r.slope * static_cast<float>(i);
+        member.at<uint8_t>(1, xr) = 255;
+      }
+      cv::Mat fast, reference;
+      const int n = label_surfaces(disp, member, 0.5f, 0.0, fast);
+      EXPECT_EQ(n, label_surfaces_reference(disp, member, 0.5f, 0.0, reference)) << r.what;
+      EXPECT_EQ(cv::countNonZero(fast != reference), 0) << r.what << " shift " << shift;
+      EXPECT_EQ(n, r.joined ? 2 : 3) << r.what << " shift " << shift;
+      EXPECT_EQ(fast.at<int>(0, 2) == fast.at<int>(1, 2 + shift), r.joined) << r.what;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace sg::vision

@@ -9,7 +9,9 @@
 /// one rigid object share one velocity (a translation; a turn adds a part that varies little
 /// across an object), so the velocity is pooled over the surface a pixel lies on before the
 /// envelope test: its noise then falls with the square root of the surface's pixel count.
+#include <cstddef>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "sg/core/camera.hpp"
 #include "sg/core/params.hpp"
@@ -24,6 +26,8 @@ namespace sg::vision {
 /// floor, and sorting it was a fifth of a Stereo-Flow run on EuRoC. Summed in another order than
 /// the sorted one, so it may differ from that by a float rounding (the test's reference sorts).
 float interquartile_mean(std::vector<float>& v);
+/// The same over v[0, n) (reordered; n > 0).
+float interquartile_mean(float* v, size_t n);
 
 /// The surfaces of pool_surface_motion: labels (CV_32S, 0 = none, 1..count-1, numbered in the
 /// raster order of each surface's first pixel) the 8-connected components of the `member` pixels
