@@ -4,10 +4,14 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <atomic>
+#include <condition_variable>
 #include <cstddef>
+#include <deque>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
+#include <thread>
 #include <tuple>
 
 namespace sg::par {
@@ -54,8 +58,9 @@ class HandoffScope {
   HandoffScope& operator=(const HandoffScope&) = delete;
 };
 
-void run_sequential(const FarmCallbacks& cb) {
+void run_sequential(const FarmConfig& config, const FarmCallbacks& cb) {
   while (std::unique_ptr<FarmItem> item = cb.emit()) {
+    if (config.not_before) std::this_thread::sleep_until(config.not_before());
     for (const std::function<void()>& task : cb.tasks(*item)) task();
     if (cb.relay) {
       for (const std::function<void()>& task : cb.relay(*item)) task();
@@ -78,6 +83,72 @@ struct Slot {
   std::atomic<std::size_t> relayed{0};    // seq + 1 once the relay replaced the tasks
   std::atomic<bool> free{true};
   bool completed = false;  // all its tasks are done; guarded by the collection lock
+  // FarmConfig::not_before, written by the emitter before `published`. Atomic, like the counts:
+  // the gate reads it, and ThreadSanitizer cannot see the TBB hand-offs that order that read
+  // before the slot's next item is emitted.
+  std::atomic<TimePoint> not_before{};
+};
+
+using SeqGate = flow::async_node<std::size_t, std::size_t>;
+
+/// Holds the items emitted before their time (FarmConfig::not_before) on a thread of its own and
+/// passes each on through the gate when its time comes, in emission order. Held on a worker, an
+/// item would leave the items in flight one worker short for the whole wait. Once stopped, what
+/// is still held is let go without being passed on (the run failed).
+class Holder {
+ public:
+  explicit Holder(SeqGate::gateway_type& gateway)
+      : gateway_(gateway), thread_([this] { loop(); }) {}
+  ~Holder() {
+    stop();
+    thread_.join();
+  }
+  Holder(const Holder&) = delete;
+  Holder& operator=(const Holder&) = delete;
+
+  void hold(std::size_t seq, TimePoint until) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (stopped_) return;     // the run failed: let go at once
+      gateway_.reserve_wait();  // the graph is not idle while the item is held
+      held_.push_back({seq, until});
+    }
+    wake_.notify_all();
+  }
+  void stop() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stopped_ = true;
+    }
+    wake_.notify_all();
+  }
+
+ private:
+  struct Held {
+    std::size_t seq;
+    TimePoint until;
+  };
+
+  void loop() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      wake_.wait(lock, [this] { return stopped_ || !held_.empty(); });
+      if (held_.empty()) return;
+      const Held next = held_.front();
+      held_.pop_front();
+      // Woken early only to stop; then the item is let go at once.
+      wake_.wait_until(lock, next.until, [this] { return stopped_; });
+      if (!stopped_) gateway_.try_put(next.seq);  // under the lock: stop() waits for it
+      gateway_.release_wait();
+    }
+  }
+
+  SeqGate::gateway_type& gateway_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<Held> held_;
+  bool stopped_ = false;
+  std::thread thread_;  // last: starts once the members it uses exist
 };
 
 /// What a message to the farm asks for: a task of an item's first round or of its relay's round,
@@ -185,7 +256,7 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
     }
   };
 
-  using EmitNode = flow::multifunction_node<TaskMsg, std::tuple<TaskMsg, std::size_t>>;
+  using EmitNode = flow::multifunction_node<TaskMsg, std::tuple<std::size_t>>;
   EmitNode emit(graph, flow::serial, [&](const TaskMsg&, EmitNode::output_ports_type& ports) {
     HandoffScope scope;
     // Just in time, the farm counted the item's first round when it gave leave to emit (so that
@@ -201,7 +272,6 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
       give_back_token();
       return;
     }
-    std::size_t n = 0;
     std::size_t seq = 0;
     {
       std::lock_guard<std::mutex> lock(emit_mutex);
@@ -221,10 +291,37 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
       slot.seq = seq;
       slot.item = std::move(item);
       slot.tasks = cb.tasks(*slot.item);
-      n = slot.tasks.size();
-      slot.remaining.store(n, std::memory_order_relaxed);
+      slot.remaining.store(slot.tasks.size(), std::memory_order_relaxed);
+      if (config.not_before) slot.not_before.store(config.not_before(), std::memory_order_relaxed);
       slot.published.store(seq + 1, std::memory_order_release);
     }
+    std::get<0>(ports).try_put(seq);
+  });
+
+  // An item whose time has not come yet (FarmConfig::not_before) waits in the holder.
+  Holder* holder = nullptr;
+  SeqGate gate(graph, flow::unlimited, [&](std::size_t seq, SeqGate::gateway_type& gateway) {
+    HandoffScope scope;
+    Slot& slot = slot_of(seq);
+    (void)slot.published.load(std::memory_order_acquire);
+    const TimePoint until = slot.not_before.load(std::memory_order_relaxed);
+    if (until > Clock::now()) {
+      holder->hold(seq, until);
+    } else {
+      gateway.try_put(seq);
+    }
+  });
+  std::optional<Holder> holding;  // after the gate: its thread stops before the gate goes
+  if (config.not_before) holder = &holding.emplace(gate.gateway());
+
+  // Starts an item: its first tasks to the farm (none: on to the relay, or collected).
+  using StartNode = flow::multifunction_node<std::size_t, std::tuple<TaskMsg, std::size_t>>;
+  auto start_item = [&](std::size_t seq, StartNode::output_ports_type& ports) {
+    HandoffScope scope;
+    Slot& slot = slot_of(seq);
+    // No task of the item has run yet, so `remaining` still counts them all (and, being atomic,
+    // is safe to read here; the relay replaces the tasks once they are done).
+    const std::size_t n = slot.remaining.load(std::memory_order_acquire);
     if (n == 0) {
       if (cb.relay) {
         std::get<1>(ports).try_put(seq);
@@ -235,7 +332,8 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
       return;
     }
     for (std::size_t i = 0; i < n; ++i) std::get<0>(ports).try_put(TaskMsg{seq, i});
-  });
+  };
+  StartNode start(graph, flow::unlimited, start_item);
 
   // Port 0: the item's first tasks are done (to the relay); port 1: leave to emit (to the
   // emitter). Items whose last tasks are done are collected here.
@@ -310,11 +408,17 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   } else {
     flow::make_edge(limiter, emit);
   }
-  flow::make_edge(flow::output_port<0>(emit), pending);
+  if (holder) {
+    flow::make_edge(flow::output_port<0>(emit), gate);
+    flow::make_edge(gate, start);
+  } else {
+    flow::make_edge(flow::output_port<0>(emit), start);
+  }
+  flow::make_edge(flow::output_port<0>(start), pending);
   flow::make_edge(pending, farm);
   if (cb.relay) {
     // Items without first tasks go through the relay too.
-    flow::make_edge(flow::output_port<1>(emit), relay_sequencer);
+    flow::make_edge(flow::output_port<1>(start), relay_sequencer);
     flow::make_edge(flow::output_port<0>(farm), relay_sequencer);
     flow::make_edge(relay_sequencer, relay);
     flow::make_edge(flow::output_port<0>(relay), pending);
@@ -327,6 +431,7 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   try {
     graph.wait_for_all();
   } catch (...) {
+    if (holder) holder->stop();  // nothing held starts after a failure
     handoff_join();
     throw;
   }
@@ -345,7 +450,7 @@ void run_farm(const FarmConfig& config, const FarmCallbacks& callbacks) {
     throw std::invalid_argument(message);
   }
   if (config.backend == Backend::kSequential) {
-    run_sequential(callbacks);
+    run_sequential(config, callbacks);
     return;
   }
   run_in_arena(config.threads, [&] { run_graph(config, callbacks); });

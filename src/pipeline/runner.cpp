@@ -105,15 +105,16 @@ class Emitter {
     previous_ = job.frame;
     if (job.frame->load_where_read()) job.frame->get();  // the emitter's work, not the farm's
     busy_ms_ += par::elapsed_ms(begin);
-    if (pace_fps_ > 0) {
-      job.acquired = capture_time(emitted_ + dropped_);
-      std::this_thread::sleep_until(job.acquired);
-    } else {
-      job.acquired = par::now();
-    }
+    // A paced frame taken before its capture time waits for it in the farm
+    // (FarmConfig::not_before), which holds it off the workers.
+    job.acquired = pace_fps_ > 0 ? capture_time(emitted_ + dropped_) : par::now();
+    acquired_ = job.acquired;
     ++emitted_;
     return job;
   }
+
+  /// When the frame emitted last was (or will be) captured.
+  par::TimePoint acquired() const { return acquired_; }
 
   /// Frames lost: dropped here, or missing from the source's indices (a live camera's drops).
   int dropped() const { return dropped_ + lost_; }
@@ -143,6 +144,7 @@ class Emitter {
   double pace_fps_;
   par::TimePoint t0_;
   std::shared_ptr<LazyFrame> previous_;
+  par::TimePoint acquired_;
   /// Under steady overload a frame is lost at every other frame taken or so; a single slow frame
   /// makes the pipeline fall behind for a few frames only.
   static constexpr int kBehindFrames = 4;
@@ -318,6 +320,7 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   // (README, Performance). A file read as fast as possible has no capture time to age from.
   if (options.pace_fps > 0 || source.live())
     farm.admit_just_in_time = [&emitter] { return emitter.falling_behind(); };
+  if (options.pace_fps > 0) farm.not_before = [&emitter] { return emitter.acquired(); };
   par::LatencyStats latency;
   const par::TimePoint start = par::now();
   emitter.start(start);

@@ -422,6 +422,80 @@ TEST(FarmAdmissionTest, EagerAdmissionEmitsDuringFirstRounds) {
   EXPECT_EQ(emits_during_first_rounds(config, 6, 20000), 0);
 }
 
+TEST_P(FarmTest, NoItemStartsItsTasksBeforeItsTime) {
+  // Items emitted at once, each due 3 ms after the one before (a paced camera's capture times).
+  constexpr int kItems = 12;
+  const TimePoint t0 = now() + std::chrono::milliseconds(5);
+  auto due = [t0](int k) { return t0 + std::chrono::milliseconds(3 * k); };
+  FarmConfig config = this->config();
+  int next = 0;
+  config.not_before = [&] { return due(next - 1); };  // right after emit: the item just emitted
+  std::vector<TimePoint> started(kItems);
+  std::vector<int> collected;
+  run_ordered_farm_tasks(
+      config,
+      [&]() -> std::optional<int> {
+        return next < kItems ? std::optional(next++) : std::nullopt;
+      },
+      [&](int& x) -> TaskList {
+        return {[&started, &x] { started[static_cast<std::size_t>(x)] = now(); }};
+      },
+      [&](int&& x) { collected.push_back(x); });
+  ASSERT_EQ(collected.size(), static_cast<std::size_t>(kItems));
+  for (int k = 0; k < kItems; ++k) EXPECT_GE(started[static_cast<std::size_t>(k)], due(k)) << k;
+}
+
+TEST(FarmHoldTest, AnItemWaitingForItsTimeLeavesBothWorkersToTheItemInFlight) {
+  // Item 0 (due in 30 ms) has two tasks that must run at once; item 1, emitted on the second
+  // token, is due only after the tasks' patience has run out. Were item 1 waited for on one of
+  // the two threads, item 0's tasks would have one thread between them and could not meet.
+  FarmConfig config{Backend::kTbb, 2, 2, 2};
+  const TimePoint t0 = now();
+  const std::chrono::milliseconds patience(1000);
+  int next = 0;
+  config.not_before = [&] {
+    return next == 1 ? t0 + std::chrono::milliseconds(30) : t0 + patience + patience / 5;
+  };
+  std::atomic<int> arrived{0};
+  std::atomic<bool> met{true};
+  auto meet = [&] {
+    ++arrived;
+    const TimePoint give_up = now() + patience;
+    while (arrived.load() < 2 && now() < give_up) pause_us(100);
+    if (arrived.load() < 2) met = false;
+  };
+  int collected = 0;
+  run_ordered_farm_tasks(
+      config,
+      [&]() -> std::optional<int> { return next < 2 ? std::optional(next++) : std::nullopt; },
+      [&](int& x) -> TaskList {
+        if (x == 0) return {meet, meet};
+        return {[] {}};
+      },
+      [&](int&&) { ++collected; });
+  EXPECT_TRUE(met.load());
+  EXPECT_EQ(collected, 2);
+}
+
+TEST_P(FarmTest, EmitterExceptionWhileAnItemWaitsForItsTime) {
+  // Item 1 waits 200 ms for its time when the emitter throws at item 2: the run stops and
+  // rethrows instead of hanging or starting what was waiting.
+  const TimePoint t0 = now();
+  FarmConfig config = this->config();
+  int next = 0;
+  config.not_before = [&] { return t0 + std::chrono::milliseconds(next == 2 ? 200 : 0); };
+  std::atomic<int> collected{0};
+  EXPECT_THROW(run_ordered_farm_tasks(
+                   config,
+                   [&]() -> std::optional<int> {
+                     if (next == 2) throw TestError(next);
+                     return std::optional(next++);
+                   },
+                   [](int&) -> TaskList { return {[] {}}; }, [&](int&&) { ++collected; }),
+               TestError);
+  EXPECT_LE(collected.load(), 2);
+}
+
 TEST_P(FarmTest, RelayTaskExceptionPropagates) {
   int next = 0;
   int collected = 0;
