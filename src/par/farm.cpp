@@ -106,14 +106,18 @@ class Holder {
   Holder(const Holder&) = delete;
   Holder& operator=(const Holder&) = delete;
 
-  void hold(std::size_t seq, TimePoint until) {
+  /// Takes the item unless its time has come and nothing is held before it (false: the caller
+  /// passes it on at once). Called in emission order.
+  bool hold(std::size_t seq, TimePoint until) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (stopped_) return;     // the run failed: let go at once
+      if (stopped_) return true;  // the run failed: let go at once
+      if (held_.empty() && !passing_ && until <= Clock::now()) return false;
       gateway_.reserve_wait();  // the graph is not idle while the item is held
       held_.push_back({seq, until});
     }
     wake_.notify_all();
+    return true;
   }
   void stop() {
     {
@@ -136,9 +140,11 @@ class Holder {
       if (held_.empty()) return;
       const Held next = held_.front();
       held_.pop_front();
+      passing_ = true;  // a later item must not overtake it while the lock is released
       // Woken early only to stop; then the item is let go at once.
       wake_.wait_until(lock, next.until, [this] { return stopped_; });
       if (!stopped_) gateway_.try_put(next.seq);  // under the lock: stop() waits for it
+      passing_ = false;
       gateway_.release_wait();
     }
   }
@@ -148,6 +154,7 @@ class Holder {
   std::condition_variable wake_;
   std::deque<Held> held_;
   bool stopped_ = false;
+  bool passing_ = false;
   std::thread thread_;  // last: starts once the members it uses exist
 };
 
@@ -298,18 +305,15 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
     std::get<0>(ports).try_put(seq);
   });
 
-  // An item whose time has not come yet (FarmConfig::not_before) waits in the holder.
+  // An item whose time has not come yet (FarmConfig::not_before) waits in the holder. The gate
+  // and the start are serial, so items reach the farm's queue in emission order (an idle worker
+  // takes whatever arrives first).
   Holder* holder = nullptr;
-  SeqGate gate(graph, flow::unlimited, [&](std::size_t seq, SeqGate::gateway_type& gateway) {
+  SeqGate gate(graph, flow::serial, [&](std::size_t seq, SeqGate::gateway_type& gateway) {
     HandoffScope scope;
     Slot& slot = slot_of(seq);
     (void)slot.published.load(std::memory_order_acquire);
-    const TimePoint until = slot.not_before.load(std::memory_order_relaxed);
-    if (until > Clock::now()) {
-      holder->hold(seq, until);
-    } else {
-      gateway.try_put(seq);
-    }
+    if (!holder->hold(seq, slot.not_before.load(std::memory_order_relaxed))) gateway.try_put(seq);
   });
   std::optional<Holder> holding;  // after the gate: its thread stops before the gate goes
   if (config.not_before) holder = &holding.emplace(gate.gateway());
@@ -333,7 +337,7 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
     }
     for (std::size_t i = 0; i < n; ++i) std::get<0>(ports).try_put(TaskMsg{seq, i});
   };
-  StartNode start(graph, flow::unlimited, start_item);
+  StartNode start(graph, flow::serial, start_item);
 
   // Port 0: the item's first tasks are done (to the relay); port 1: leave to emit (to the
   // emitter). Items whose last tasks are done are collected here.
