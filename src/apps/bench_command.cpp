@@ -1,5 +1,6 @@
 // `stereoguard bench`: throughput and latency of the pipeline configurations beside a plain
 // sequential OpenCV loop measured in the same run.
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -55,6 +56,19 @@ void print_capacity(const pipeline::BenchRow& r) {
     std::cout << "; over " << 100.0 * kNoisySpread
               << " %: the machine's speed changed between runs, so the pace may not be the "
                  "fraction asked for; run again";
+  std::cout << ")" << std::endl;
+}
+
+/// Whether the machine kept the capacity's speed while the paced rows ran (a "recheck" row).
+void print_recheck(const pipeline::BenchRow& r) {
+  const double off = r.fps / r.capacity_fps - 1.0;
+  std::cout << std::fixed << std::setprecision(1) << "(after the paced rows: W " << r.workers
+            << " T " << r.tiles << " ran " << r.fps << " fps, " << 100.0 * off
+            << " % against the capacity";
+  if (std::abs(off) > kNoisySpread)
+    std::cout << "; over " << 100.0 * kNoisySpread
+              << " %: the machine's speed changed while the paced rows ran, so their pace may not "
+                 "be the fraction asked for; run again";
   std::cout << ")" << std::endl;
 }
 
@@ -134,6 +148,7 @@ void bench_main(const BenchArgs& a) {
       capacity_told = row.mode;
     }
     print_row(row);
+    if (row.kind == "recheck") print_recheck(row);
     csv << pipeline::to_csv(row) << "\n" << std::flush;
   });
   std::cout << "csv: " << a.csv << "\n";
@@ -163,7 +178,7 @@ void add_bench_command(CLI::App& app) {
                   "baselines stay StereoBM)");
   cmd->add_option("--cost", a->cost, "fast matcher cost: sad (default) or census");
   cmd->add_option("--threads", a->threads, "task-arena size (default 0 = all cores)");
-  cmd->add_option("--tokens", a->tokens, "frames in flight of the pipeline rows (default 0: W + 1, or W when paced)");
+  cmd->add_option("--tokens", a->tokens, "frames in flight of the pipeline rows (default 0: W + 1)");
   cmd->add_option("--scenario", a->scenario, "scenario rendered for the frames (default head-on)");
   cmd->add_option("--pace", a->pace,
                   "also pace the best configuration (lowest p99 within 5 % of the top fps) at "

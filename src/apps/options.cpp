@@ -143,7 +143,7 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
   app.add_option("--workers", o.workers,
                  "W: farm workers computing SM/OF tasks at once (default 1)");
   app.add_option("--tiles", o.tiles, "T: row tiles per task (default 1)");
-  app.add_option("--tokens", o.tokens, "frames in flight (default 0: W + 1, or W when paced with --fps)");
+  app.add_option("--tokens", o.tokens, "frames in flight (default 0: W + 1)");
   app.add_option("--threads", o.threads, "threads of the task arena (default 0 = all cores)");
   app.add_flag("--tile-flow", o.tile_flow,
                "split optical flow into the T tiles too (faster, not bit-identical)");

@@ -331,8 +331,8 @@ TEST_F(Cli, BenchWritesOneCsvRowPerConfigurationBesideItsBaselines) {
   std::vector<std::string> rows;
   for (std::string line; std::getline(csv, line);) rows.push_back(line);
   // header, baseline, opencv-mt, 4 pipeline configurations, 2 more capacity runs of the best
-  // one, 1 paced run
-  ASSERT_EQ(rows.size(), 10u) << r.out;
+  // one, 1 paced run, 1 recheck run of the best one after it
+  ASSERT_EQ(rows.size(), 11u) << r.out;
   EXPECT_EQ(rows[0].rfind("kind,mode,width,height,workers,tiles", 0), 0u);
   EXPECT_EQ(rows[1].rfind("baseline,stereo,161,121,", 0), 0u) << rows[1];
   EXPECT_EQ(rows[2].rfind("opencv-mt,stereo,161,121,", 0), 0u) << rows[2];
@@ -346,6 +346,7 @@ TEST_F(Cli, BenchWritesOneCsvRowPerConfigurationBesideItsBaselines) {
   EXPECT_EQ(rows[7].rfind("capacity,stereo,161,121,", 0), 0u) << rows[7];
   EXPECT_EQ(rows[8].rfind("capacity,stereo,161,121,", 0), 0u) << rows[8];
   EXPECT_EQ(rows[9].rfind("paced,stereo,161,121,", 0), 0u) << rows[9];
+  EXPECT_EQ(rows[10].rfind("recheck,stereo,161,121,", 0), 0u) << rows[10];
   // The pace is 2 x the median fps of the best configuration's three runs (its sweep row and the
   // two capacity rows, which share its W and T).
   auto field = [](const std::string& row, int k) {
@@ -373,6 +374,21 @@ TEST_F(Cli, BenchWritesOneCsvRowPerConfigurationBesideItsBaselines) {
   ASSERT_NE(spread, std::string::npos) << runs << "\n" << r.out;
   EXPECT_NEAR(std::stod(r.out.substr(spread + runs.size())),
               100.0 * (capacity[2] - capacity[0]) / capacity[1], 0.051)
+      << r.out;
+  // The recheck runs the paced configuration unpaced and says how far it is from that capacity.
+  EXPECT_EQ(field(rows[10], 4), field(rows[9], 4));
+  EXPECT_EQ(field(rows[10], 5), field(rows[9], 5));
+  EXPECT_EQ(std::stod(field(rows[10], 7)), 0.0);
+  const std::string after = "(after the paced rows: W " + field(rows[9], 4) + " T " +
+                            field(rows[9], 5) + " ran ";
+  const size_t again = r.out.find(after);
+  ASSERT_NE(again, std::string::npos) << r.out;
+  EXPECT_GT(again, r.out.find("\nrecheck ")) << r.out;
+  const double recheck_fps = std::stod(field(rows[10], 11));
+  EXPECT_NEAR(std::stod(r.out.substr(again + after.size())), recheck_fps, 0.051) << r.out;
+  const size_t off_at = r.out.find(" fps, ", again + after.size());
+  ASSERT_NE(off_at, std::string::npos) << r.out;
+  EXPECT_NEAR(std::stod(r.out.substr(off_at + 6)), 100.0 * (recheck_fps / capacity[1] - 1.0), 0.051)
       << r.out;
   EXPECT_GT(fs::file_size(dir_ / "b.png"), 1000u);
   // The pipeline rows use run's default matcher (it once said fast and ran bm).

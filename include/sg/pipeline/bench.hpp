@@ -33,6 +33,8 @@ struct BenchConfig {
   /// configuration (its sweep row and capacity_runs - 1 more, rows of kind "capacity"), 1..9. One
   /// run of 150 frames on a busy 2-core machine reads up to 20 % off (head-on, W 2 T 2: 97-112
   /// fps in six sweeps), and a pace set from a run that read high is no longer 80 % of capacity.
+  /// With more than one, one more unpaced run follows the paced rows (kind "recheck"): whether
+  /// the machine kept its speed while they ran.
   int capacity_runs = 3;
   /// When set, the frames come from this input instead of the scenario: read once into memory (up
   /// to `frames`, played forwards then backwards when shorter), at the input's own resolution and
@@ -44,7 +46,8 @@ std::vector<std::string> validate(const BenchConfig& config);
 
 struct BenchRow {
   /// "baseline" (plain loop, OpenCV on one thread: the reference), "opencv-mt" (the same loop
-  /// with OpenCV's own parallel loops), "pipeline" or "paced"
+  /// with OpenCV's own parallel loops), "pipeline", "capacity" (more runs of the best pipeline
+  /// row), "paced" or "recheck" (the best row once more, after the paced rows)
   std::string kind;
   std::string mode;        ///< "stereo" / "stereo-flow"
   cv::Size resolution;
@@ -58,7 +61,7 @@ struct BenchRow {
   /// Per-frame signals equal to the baseline's (pipeline rows) / to the unpaced run's (paced rows:
   /// only comparable when nothing was dropped).
   bool same_detections = true;
-  /// Paced rows: the capacity the pace is a fraction of (the median fps of the capacity runs of
+  /// Paced and recheck rows: the capacity the pace is a fraction of (the median fps of the capacity runs of
   /// this configuration), the number of those runs, and their spread, (max - min) / median: a
   /// large spread means the machine's speed changed between runs, so the pace may not be the
   /// fraction of the capacity that was asked for. Not in the CSV.

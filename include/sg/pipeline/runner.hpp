@@ -26,9 +26,9 @@ struct RunOptions {
   double pace_fps = 0.0;
   int workers = 1;  ///< W >= 1: farm tasks (SM, OF) running at once
   int tiles = 1;    ///< T >= 1: row tiles per task
-  /// Frames in flight; 0 = automatic: W + 1 for a file read as fast as possible, W when paced
-  /// (bench, 640x480 Stereo-Flow W 2 T 2 at 150 % of its capacity: p99 latency 43.1 ms with 3
-  /// tokens, 25.7 ms with 2, at the same throughput).
+  /// Frames in flight; 0 = automatic: W + 1, one frame ready beyond the workers (paced, it is
+  /// held until its capture, so a run of costly frames delays it instead of losing it; README,
+  /// Performance, has the paced figures against W tokens).
   int tokens = 0;
   int threads = 0;  ///< task-arena size; 0 = all cores
   /// Split the optical-flow task into tiles too. Off by default: DIS works on an image pyramid,
