@@ -178,7 +178,8 @@ void add_bench_command(CLI::App& app) {
                   "baselines stay StereoBM)");
   cmd->add_option("--cost", a->cost, "fast matcher cost: sad (default) or census");
   cmd->add_option("--threads", a->threads, "task-arena size (default 0 = all cores)");
-  cmd->add_option("--tokens", a->tokens, "frames in flight of the pipeline rows (default 0: W + 1)");
+  cmd->add_option("--tokens", a->tokens,
+                  "frames in flight of the pipeline rows (default 0: W + 1)");
   cmd->add_option("--scenario", a->scenario, "scenario rendered for the frames (default head-on)");
   cmd->add_option("--pace", a->pace,
                   "also pace the best configuration (lowest p99 within 5 % of the top fps) at "

@@ -8,7 +8,6 @@
 #include <mutex>
 #include <numeric>
 #include <sstream>
-#include <thread>
 
 #include "sg/core/error.hpp"
 #include "sg/par/backend.hpp"

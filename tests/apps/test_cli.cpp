@@ -388,7 +388,8 @@ TEST_F(Cli, BenchWritesOneCsvRowPerConfigurationBesideItsBaselines) {
   EXPECT_NEAR(std::stod(r.out.substr(again + after.size())), recheck_fps, 0.051) << r.out;
   const size_t off_at = r.out.find(" fps, ", again + after.size());
   ASSERT_NE(off_at, std::string::npos) << r.out;
-  EXPECT_NEAR(std::stod(r.out.substr(off_at + 6)), 100.0 * (recheck_fps / capacity[1] - 1.0), 0.051)
+  EXPECT_NEAR(std::stod(r.out.substr(off_at + 6)), 100.0 * (recheck_fps / capacity[1] - 1.0),
+              0.051)
       << r.out;
   EXPECT_GT(fs::file_size(dir_ / "b.png"), 1000u);
   // The pipeline rows use run's default matcher (it once said fast and ran bm).

@@ -61,10 +61,10 @@ struct BenchRow {
   /// Per-frame signals equal to the baseline's (pipeline rows) / to the unpaced run's (paced rows:
   /// only comparable when nothing was dropped).
   bool same_detections = true;
-  /// Paced and recheck rows: the capacity the pace is a fraction of (the median fps of the capacity runs of
-  /// this configuration), the number of those runs, and their spread, (max - min) / median: a
-  /// large spread means the machine's speed changed between runs, so the pace may not be the
-  /// fraction of the capacity that was asked for. Not in the CSV.
+  /// Paced and recheck rows: the capacity the pace is a fraction of (the median fps of the
+  /// capacity runs of this configuration), the number of those runs, and their spread, (max -
+  /// min) / median: a large spread means the machine's speed changed between runs, so the pace
+  /// may not be the fraction of the capacity that was asked for. Not in the CSV.
   double capacity_fps = 0.0, capacity_spread = 0.0;
   int capacity_runs = 0;
 };
