@@ -218,7 +218,7 @@ TEST(FuzzFindings, KittiRectifiedSizeBeyondIntIsAnInputError) {
         << "S_rect_01: 1.242e+03 3.75e+02\n"
         << "P_rect_01: 7.2e+02 0 6.0e+02 -3.9e+02 0 7.2e+02 1.7e+02 0 0 0 1 0\n";
   };
-  for (const std::string& bad : {"1.242e+43 3.75e+02", "1242.5 375", "0 375", "-1 375"}) {
+  for (const char* bad : {"1.242e+43 3.75e+02", "1242.5 375", "0 375", "-1 375"}) {
     write(bad);
     EXPECT_TRUE(contains(
         input_error_of([&] { read_kitti_calibration(dir.path() / "calib_cam_to_cam.txt", 0, 1); }),

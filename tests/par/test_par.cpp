@@ -391,7 +391,9 @@ int emits_during_first_rounds(FarmConfig config, int items, int first_us,
           --in_flight;
         }
         order.push_back(r.index);
-        if (r.index % 7 != 6 && r.index % 5 != 4) EXPECT_EQ(r.history_sum, r.index);
+        if (r.index % 7 != 6 && r.index % 5 != 4) {
+          EXPECT_EQ(r.history_sum, r.index);
+        }
       });
   std::vector<int> expected(static_cast<std::size_t>(items));
   std::iota(expected.begin(), expected.end(), 0);

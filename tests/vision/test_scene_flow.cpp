@@ -238,15 +238,19 @@ TEST(LabelStereoFlow, HeadOnPatchIsDangerous) {
 }
 
 // chain_stride: candidates nearer than chain_stride_z_m are followed on every second row and
-// column only, those nearer than half of it on every fourth, far ones all; pooling then gives the
-// unfollowed ones their surface's velocity, and the pooled mask is the one of following every
-// candidate. Without pooling the stride is off.
+// column only, those sqrt(2) nearer on every fourth column, those nearer than half of it on every
+// fourth row and column, far ones all; pooling then gives the unfollowed ones their surface's
+// velocity, and the pooled mask is the one of following every candidate. Without pooling the
+// stride is off.
 TEST(LabelStereoFlow, ChainStrideFollowsFewerNearPixelsTheNearerAndPoolingFillsTheRest) {
   const core::Camera cam = odd_camera();  // f B = 20
   Maps m = wall(cam);
   const cv::Rect nearest(60, 45, 31, 27), near(100, 80, 31, 27), far_patch(10, 10, 21, 15);
+  const cv::Rect between(10, 80, 31, 27);
   m.prev(nearest).setTo(20.0 / 2.0);  // 2.0 m -> 1.9 m: under half the stride zone's 4 m
   m.cur(nearest).setTo(20.0 / 1.9);
+  m.prev(between).setTo(20.0 / 2.6);  // 2.6 m -> 2.5 m: under 4 m / sqrt(2), over 2 m
+  m.cur(between).setTo(20.0 / 2.5);
   m.prev(near).setTo(20.0 / 3.1);  // 3.1 m -> 3.0 m: in the stride zone
   m.cur(near).setTo(20.0 / 3.0);
   m.prev(far_patch).setTo(20.0 / 6.2);  // 6.2 m -> 6.1 m: far, followed everywhere
@@ -260,19 +264,25 @@ TEST(LabelStereoFlow, ChainStrideFollowsFewerNearPixelsTheNearerAndPoolingFillsT
   cv::Mat d2, t2, v2, d1, t1, v1;
   label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, strided, kDt, d2, t2, v2);
   label_stereo_flow(m.cur, m.prev, m.flow, cam, {}, every, kDt, d1, t1, v1);
-  for (const auto& [patch, stride] : {std::pair{nearest, 4}, std::pair{near, 2}})
-    for (int y = patch.y; y < patch.br().y; ++y)
-      for (int x = patch.x; x < patch.br().x; ++x) {
-        const bool followed = y % stride == 0 && x % stride == 0;
+  struct Strided {
+    cv::Rect patch;
+    int columns, rows;
+  };
+  for (const Strided& s : {Strided{nearest, 4, 4}, Strided{between, 4, 2}, Strided{near, 2, 2}})
+    for (int y = s.patch.y; y < s.patch.br().y; ++y)
+      for (int x = s.patch.x; x < s.patch.br().x; ++x) {
+        const bool followed = y % s.rows == 0 && x % s.columns == 0;
         EXPECT_EQ(std::isnan(v2.at<cv::Vec3f>(y, x)[2]), !followed) << x << "," << y;
-        if (stride == 4) EXPECT_EQ(d2.at<uint8_t>(y, x) != 0, followed) << x << "," << y;
+        if (s.rows == 4) {
+          EXPECT_EQ(d2.at<uint8_t>(y, x) != 0, followed) << x << "," << y;
+        }
       }
   EXPECT_EQ(cv::countNonZero(d2(far_patch) != d1(far_patch)), 0);
   EXPECT_EQ(cv::countNonZero(d1(nearest)), nearest.area());
   // Pooled, the strided labelling marks what following every candidate marks.
   // Depth edges one pixel outside each patch part it from the wall.
   cv::Mat edges = cv::Mat::zeros(m.cur.size(), CV_8U);
-  for (const cv::Rect& r : {nearest, near, far_patch})
+  for (const cv::Rect& r : {nearest, between, near, far_patch})
     cv::rectangle(edges, r - cv::Point(1, 1) + cv::Size(2, 2), 255, 1);
   pool_surface_motion(m.cur, cam, {}, strided, kDt, edges, d2, t2, v2);
   pool_surface_motion(m.cur, cam, {}, every, kDt, edges, d1, t1, v1);

@@ -154,7 +154,9 @@ TEST(ObstacleTracker, TrackNearerThanTheMatcherSeesCoastsUntilContact) {
         continue;
       }
       if (!coast) {
-        if (z <= 1.0) EXPECT_TRUE(obs.empty()) << i;
+        if (z <= 1.0) {
+          EXPECT_TRUE(obs.empty()) << i;
+        }
         continue;
       }
       ASSERT_EQ(obs.size(), 1u) << i << " z " << z;

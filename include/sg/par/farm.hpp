@@ -47,13 +47,13 @@ struct FarmConfig {
   /// instead of waiting in the queue while the older items' first rounds take every worker.
   /// Null (the default): admitted as soon as a token frees. Called from the farm's threads,
   /// never concurrently with itself. Ignored by kSequential.
-  std::function<bool()> admit_just_in_time;
+  std::function<bool()> admit_just_in_time{};
   /// The earliest time the item just emitted may start its tasks (a paced camera: the frame's
   /// capture time); called right after each emit(), in the same serial context. An item emitted
   /// before its time waits on a thread of the farm's own, outside the workers, so no worker
   /// sleeps while the items in flight could use it (kSequential sleeps on its one thread). Null
   /// (the default): every item starts as soon as it is emitted.
-  std::function<TimePoint()> not_before;
+  std::function<TimePoint()> not_before{};
 };
 
 /// Every violation as "par.<field>=<value>: <rule>"; empty when valid.

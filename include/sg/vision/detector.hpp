@@ -27,16 +27,16 @@ namespace sg::vision {
 /// What the workers computed for one frame.
 struct FrameMaps {
   /// CV_32F, px, invalid < 0; empty for the detectors that do not need it (core::needs).
-  cv::Mat disparity;
+  cv::Mat disparity{};
   /// CV_32FC2 backward flow B_i from L_i to the left image of the previous frame that reached the
   /// detector (Stereo-Flow mode), empty for the first frame and in Stereo mode.
-  cv::Mat flow;
+  cv::Mat flow{};
   /// Optional CV_8U depth-edge mask of `disparity` (depth_edges()); computed by prepare() when
   /// empty in Stereo-Flow mode. A worker may compute it right after the disparity.
-  cv::Mat edges;
+  cv::Mat edges{};
   /// The frame's left image (CV_8U), a share: relative-size and sceneflow-seg read it (and the
   /// earlier frames' from the history). Detector::process takes the frame's when empty.
-  cv::Mat left;
+  cv::Mat left{};
 };
 
 /// The depth-edge mask the Stereo-Flow labelling uses for `disparity` (mark_depth_edges with the
