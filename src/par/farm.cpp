@@ -184,14 +184,6 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   std::mutex relay_mutex;
 
   flow::graph graph;
-  // A tick per item to emit while the stream lasts; it passes the limiter with a token.
-  flow::input_node<TaskMsg> ticks(graph, [&ended](tbb::flow_control& control) {
-    HandoffScope scope;
-    if (ended.load(std::memory_order_acquire)) control.stop();
-    return kAdmitMsg;
-  });
-  flow::limiter_node<TaskMsg, int> limiter(graph, tokens);
-  auto give_back_token = [&limiter] { limiter.decrementer().try_put(1); };
 
   // A worker that comes free takes the oldest item's task first: a frame's labelling (the relay's
   // tasks) does not wait behind the next frame's stereo and flow tasks that were queued before it,
@@ -231,6 +223,7 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   std::mutex collect_mutex;
   std::size_t next_collect = 0;
   bool collecting = false;
+  std::function<void()> give_back_token;  // below: emits the next item, or asks leave to
   auto complete = [&](std::size_t seq) {
     std::unique_lock<std::mutex> lock(collect_mutex);
     slot_of(seq).completed = true;
@@ -263,20 +256,24 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
     }
   };
 
-  using EmitNode = flow::multifunction_node<TaskMsg, std::tuple<std::size_t>>;
-  EmitNode emit(graph, flow::serial, [&](const TaskMsg&, EmitNode::output_ports_type& ports) {
-    HandoffScope scope;
-    // Just in time, the farm counted the item's first round when it gave leave to emit (so that
-    // two leaves cannot both pass before either item exists); otherwise it starts here.
-    const bool just_in_time = static_cast<bool>(config.admit_just_in_time);
-    if (!just_in_time) {
+  // Emits the next item with a token, serially (emit_mutex), on the thread that has the token:
+  // the thread that collected an item, the farm task that gave leave just in time, or the emit
+  // node for the first tokens. A token used to pass a limiter_node and, whenever just-in-time
+  // admission was configured, the farm's queue behind every task queued there, even while
+  // admit_just_in_time() answered no: a paced run took its next frame 2.7 ms after the token
+  // came back at the median and up to 24 ms (a task later), and lost it when that was past the
+  // next capture (README, Performance, "A freed token takes the next frame at once").
+  flow::receiver<std::size_t>* first_stop = nullptr;  // the gate (paced) or the start
+  auto emit_one = [&](bool counted) {
+    // `counted`: whoever gave leave counted the item's first round already (so that two leaves
+    // cannot both pass before either item exists); otherwise it starts here.
+    if (!counted) {
       std::lock_guard<std::mutex> lock(admit_mutex);
       ++first_round;
       ++in_flight;
     }
     if (ended.load(std::memory_order_acquire)) {
-      admission_after(true, true);
-      give_back_token();
+      admission_after(true, true);  // the stream is over: the token is not given back
       return;
     }
     std::size_t seq = 0;
@@ -286,7 +283,6 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
       if (!item) {
         ended.store(true, std::memory_order_release);
         admission_after(true, true);
-        give_back_token();
         return;
       }
       seq = next_seq++;
@@ -302,7 +298,28 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
       if (config.not_before) slot.not_before.store(config.not_before(), std::memory_order_relaxed);
       slot.published.store(seq + 1, std::memory_order_release);
     }
-    std::get<0>(ports).try_put(seq);
+    first_stop->try_put(seq);
+  };
+  give_back_token = [&] {
+    if (config.admit_just_in_time) {
+      {
+        std::lock_guard<std::mutex> lock(admit_mutex);
+        if (config.admit_just_in_time()) {
+          pending.try_put(kAdmitMsg);  // behind: admitted by the farm when it may (kAdmit)
+          return;
+        }
+        ++first_round;  // the item about to be emitted
+        ++in_flight;
+      }
+      emit_one(true);
+    } else {
+      emit_one(false);
+    }
+  };
+  flow::function_node<TaskMsg> emit(graph, flow::serial, [&](const TaskMsg&) {
+    HandoffScope scope;
+    emit_one(false);
+    return flow::continue_msg();
   });
 
   // An item whose time has not come yet (FarmConfig::not_before) waits in the holder. The gate
@@ -339,10 +356,9 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   };
   StartNode start(graph, flow::serial, start_item);
 
-  // Port 0: the item's first tasks are done (to the relay); port 1: leave to emit (to the
-  // emitter). Items whose last tasks are done are collected here.
-  using FarmNode =
-      flow::multifunction_node<TaskMsg, std::tuple<std::size_t, TaskMsg>, flow::rejecting>;
+  // Port 0: the item's first tasks are done (to the relay). Items whose last tasks are done are
+  // collected here; a leave to emit (just in time) emits here.
+  using FarmNode = flow::multifunction_node<TaskMsg, std::tuple<std::size_t>, flow::rejecting>;
   FarmNode farm(graph, static_cast<std::size_t>(config.workers),
                 [&](const TaskMsg& msg, FarmNode::output_ports_type& ports) {
                   HandoffScope scope;
@@ -359,7 +375,7 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
                       ++first_round;  // the item about to be emitted
                       ++in_flight;
                     }
-                    std::get<1>(ports).try_put(msg);
+                    emit_one(true);
                     return;
                   }
                   Slot& slot = slot_of(msg.seq);
@@ -405,18 +421,11 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
     if (n == 0) complete(seq);
   });
 
-  flow::make_edge(ticks, limiter);
-  if (config.admit_just_in_time) {
-    flow::make_edge(limiter, pending);
-    flow::make_edge(flow::output_port<1>(farm), emit);
-  } else {
-    flow::make_edge(limiter, emit);
-  }
   if (holder) {
-    flow::make_edge(flow::output_port<0>(emit), gate);
+    first_stop = &gate;
     flow::make_edge(gate, start);
   } else {
-    flow::make_edge(flow::output_port<0>(emit), start);
+    first_stop = &start;
   }
   flow::make_edge(flow::output_port<0>(start), pending);
   flow::make_edge(pending, farm);
@@ -429,7 +438,14 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   }
 
   handoff_start();
-  ticks.activate();
+  // The first tokens; each later one is given back when its item is collected.
+  for (std::size_t t = 0; t < tokens; ++t) {
+    if (config.admit_just_in_time) {
+      pending.try_put(kAdmitMsg);
+    } else {
+      emit.try_put(kAdmitMsg);
+    }
+  }
   // Rethrows the first exception of a node body after the graph's context was cancelled: no new
   // node body starts, running ones finish, buffered messages are dropped with the nodes.
   try {

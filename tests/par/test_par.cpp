@@ -424,6 +424,58 @@ TEST(FarmAdmissionTest, EagerAdmissionEmitsDuringFirstRounds) {
   EXPECT_EQ(emits_during_first_rounds(config, 6, 20000), 0);
 }
 
+/// What ran, in the order it ran, from any thread.
+class EventLog {
+ public:
+  void note(const std::string& what) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    events_.push_back(what);
+  }
+  /// Where `what` stands (events().size() when absent).
+  std::ptrdiff_t at(const std::string& what) const {
+    return std::find(events_.begin(), events_.end(), what) - events_.begin();
+  }
+  const std::vector<std::string>& events() const { return events_; }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::string> events_;
+};
+
+TEST(FarmAdmissionTest, ATokenComesBackAsTheNextItemNotBehindTheQueuedTasks) {
+  // One worker, two tokens: item 1's task is queued while item 0's runs. When item 0 is
+  // collected its token emits item 2 at once, on the thread that collected it, before the worker
+  // takes item 1's task; just-in-time admission configured but answering no changes nothing (its
+  // leave used to wait in the farm's queue behind item 1's task, so a paced camera's frame was
+  // taken a task later and lost).
+  for (const bool configured : {false, true}) {
+    FarmConfig config{Backend::kTbb, 1, 2, 2};
+    if (configured) config.admit_just_in_time = [] { return false; };
+    EventLog log;
+    auto note = [&log](const std::string& what) { log.note(what); };
+    int next = 0;
+    run_ordered_farm_tasks(
+        config,
+        [&]() -> std::optional<int> {
+          if (next == 4) return std::nullopt;
+          note("emit " + std::to_string(next));
+          return next++;
+        },
+        [&](int& item) -> TaskList {
+          return {[&note, item] {
+            note("task " + std::to_string(item) + " starts");
+            pause_us(30000);
+          }};
+        },
+        [&](int&& item) { note("collect " + std::to_string(item)); });
+    const std::string trace = ::testing::PrintToString(log.events());
+    ASSERT_EQ(log.events().size(), 12u) << trace;
+    EXPECT_LT(log.at("collect 0"), log.at("emit 2")) << trace;  // the token came from item 0
+    EXPECT_LT(log.at("emit 2"), log.at("task 1 starts")) << configured << trace;
+    EXPECT_LT(log.at("emit 3"), log.at("task 2 starts")) << configured << trace;
+  }
+}
+
 TEST_P(FarmTest, NoItemStartsItsTasksBeforeItsTime) {
   // Items emitted at once, each due 3 ms after the one before (a paced camera's capture times).
   constexpr int kItems = 12;
@@ -611,12 +663,8 @@ INSTANTIATE_TEST_SUITE_P(Backends, FarmTest, testing::ValuesIn(kCases), case_nam
 // relay runs while the worker sleeps.
 TEST(FarmOrderTest, AFreeWorkerTakesTheOldestItemsTaskFirst) {
   const FarmConfig config{Backend::kTbb, 1, 2, 2};
-  std::mutex mutex;
-  std::vector<std::string> ran;
-  auto note = [&](const std::string& what) {
-    const std::lock_guard<std::mutex> lock(mutex);
-    ran.push_back(what);
-  };
+  EventLog log;
+  auto note = [&log](const std::string& what) { log.note(what); };
   int next = 0;
   run_ordered_farm_relay(
       config,
@@ -638,13 +686,11 @@ TEST(FarmOrderTest, AFreeWorkerTakesTheOldestItemsTaskFirst) {
         return {[&note, item] { note("relay " + std::to_string(item)); }};
       },
       [](int&&) {});
+  const std::vector<std::string>& ran = log.events();
   ASSERT_EQ(ran.size(), 5u);
   EXPECT_EQ(ran.front(), "first 0");
   EXPECT_EQ(ran.back(), "relay 1");
-  auto at = [&ran](const std::string& what) {
-    return std::find(ran.begin(), ran.end(), what) - ran.begin();
-  };
-  EXPECT_LT(at("relay 0"), at("first 1b")) << ::testing::PrintToString(ran);
+  EXPECT_LT(log.at("relay 0"), log.at("first 1b")) << ::testing::PrintToString(ran);
 }
 
 TEST(FarmConfigTest, ValidateNamesEachBadField) {

@@ -6,7 +6,8 @@
 /// The emitter returns the next item or std::nullopt at end of stream. Workers run the item's
 /// tasks; the collector receives items in emission order. At most `tokens` items are in flight
 /// (emitted and not yet collected), so a slow collector or farm throttles the emitter instead of
-/// building a queue. Knows nothing about images.
+/// building a queue; the collection that gives a token back emits the next item at once, on its
+/// own thread. Knows nothing about images.
 ///
 ///   sg::par::FarmConfig config{sg::par::Backend::kTbb, /*workers=*/2, /*tokens=*/4,
 ///                              /*threads=*/2};
@@ -45,7 +46,9 @@ struct FarmConfig {
   /// older task to take. For a live source that is
   /// falling behind: the item is then taken from it as late as it can start, so it is fresher,
   /// instead of waiting in the queue while the older items' first rounds take every worker.
-  /// Null (the default): admitted as soon as a token frees. Called from the farm's threads,
+  /// Null (the default), or while it returns false: admitted as soon as a token frees, by the
+  /// thread that freed it (the next item is emitted right after the collection that gave its
+  /// token back, not behind the tasks queued for the workers). Called from the farm's threads,
   /// never concurrently with itself. Ignored by kSequential.
   std::function<bool()> admit_just_in_time{};
   /// The earliest time the item just emitted may start its tasks (a paced camera: the frame's
