@@ -177,9 +177,11 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   std::vector<Slot> ring(tokens);
   auto slot_of = [&ring, tokens](std::size_t seq) -> Slot& { return ring[seq % tokens]; };
   std::atomic<bool> ended{false};
-  std::size_t next_seq = 0;  // only touched by the serial emit node
-  // Uncontended locks (the nodes are serial already). They make the order between consecutive
-  // emitter (collector) calls on different threads visible to ThreadSanitizer.
+  std::size_t next_seq = 0;  // under emit_mutex
+  // Emissions run on whichever thread has the token (a collection and a just-in-time leave can
+  // race), so emit_mutex keeps them one at a time and in order. The relay's node is serial
+  // already; its lock makes the order between consecutive relay calls on different threads
+  // visible to ThreadSanitizer.
   std::mutex emit_mutex;
   std::mutex relay_mutex;
 
@@ -272,49 +274,44 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
       ++first_round;
       ++in_flight;
     }
+    // Under the lock, so that the emitter is not called again once it has returned nothing, and
+    // the gate (Holder::hold) and the start receive items in emission order.
+    std::lock_guard<std::mutex> lock(emit_mutex);
     if (ended.load(std::memory_order_acquire)) {
       admission_after(true, true);  // the stream is over: the token is not given back
       return;
     }
-    std::size_t seq = 0;
-    {
-      std::lock_guard<std::mutex> lock(emit_mutex);
-      std::unique_ptr<FarmItem> item = cb.emit();
-      if (!item) {
-        ended.store(true, std::memory_order_release);
-        admission_after(true, true);
-        return;
-      }
-      seq = next_seq++;
-      Slot& slot = slot_of(seq);
-      if (!slot.free.load(std::memory_order_acquire)) {
-        throw std::logic_error("sg::par farm: slot reused while in flight");
-      }
-      slot.free.store(false, std::memory_order_relaxed);
-      slot.seq = seq;
-      slot.item = std::move(item);
-      slot.tasks = cb.tasks(*slot.item);
-      slot.remaining.store(slot.tasks.size(), std::memory_order_relaxed);
-      if (config.not_before) slot.not_before.store(config.not_before(), std::memory_order_relaxed);
-      slot.published.store(seq + 1, std::memory_order_release);
+    std::unique_ptr<FarmItem> item = cb.emit();
+    if (!item) {
+      ended.store(true, std::memory_order_release);
+      admission_after(true, true);
+      return;
     }
-    first_stop->try_put(seq);
+    const std::size_t seq = next_seq++;
+    Slot& slot = slot_of(seq);
+    if (!slot.free.load(std::memory_order_acquire)) {
+      throw std::logic_error("sg::par farm: slot reused while in flight");
+    }
+    slot.free.store(false, std::memory_order_relaxed);
+    slot.seq = seq;
+    slot.item = std::move(item);
+    slot.tasks = cb.tasks(*slot.item);
+    slot.remaining.store(slot.tasks.size(), std::memory_order_relaxed);
+    if (config.not_before) slot.not_before.store(config.not_before(), std::memory_order_relaxed);
+    slot.published.store(seq + 1, std::memory_order_release);
+    first_stop->try_put(seq);  // queues or spawns the node's task; never runs it here
   };
   give_back_token = [&] {
-    if (config.admit_just_in_time) {
-      {
-        std::lock_guard<std::mutex> lock(admit_mutex);
-        if (config.admit_just_in_time()) {
-          pending.try_put(kAdmitMsg);  // behind: admitted by the farm when it may (kAdmit)
-          return;
-        }
-        ++first_round;  // the item about to be emitted
-        ++in_flight;
+    {
+      std::lock_guard<std::mutex> lock(admit_mutex);
+      if (config.admit_just_in_time && config.admit_just_in_time()) {
+        pending.try_put(kAdmitMsg);  // behind: admitted by the farm when it may (kAdmit)
+        return;
       }
-      emit_one(true);
-    } else {
-      emit_one(false);
+      ++first_round;  // the item about to be emitted
+      ++in_flight;
     }
+    emit_one(true);
   };
   flow::function_node<TaskMsg> emit(graph, flow::serial, [&](const TaskMsg&) {
     HandoffScope scope;

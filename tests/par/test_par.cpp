@@ -424,6 +424,33 @@ TEST(FarmAdmissionTest, EagerAdmissionEmitsDuringFirstRounds) {
   EXPECT_EQ(emits_during_first_rounds(config, 6, 20000), 0);
 }
 
+TEST(FarmAdmissionTest, TheEmitterIsNotCalledAgainAfterTheEnd) {
+  // A collection emits on its own thread while a just-in-time leave emits on a worker: two
+  // emissions can race. The one that finds the stream over must not call the emitter again
+  // (whose end, here, takes 2 ms, so that the other is waiting by then).
+  for (int run = 0; run < 40; ++run) {
+    FarmConfig config{Backend::kTbb, 2, 3, 2};
+    std::atomic<int> asked{0};
+    config.admit_just_in_time = [&asked] { return asked.fetch_add(1) % 2 == 0; };
+    int next = 0;
+    int calls_after_end = 0;
+    bool over = false;
+    run_ordered_farm_tasks(
+        config,
+        [&]() -> std::optional<int> {
+          if (over) ++calls_after_end;
+          if (next == 12) {
+            pause_us(2000);
+            over = true;
+            return std::nullopt;
+          }
+          return next++;
+        },
+        [](int&) -> TaskList { return {[] { pause_us(300); }}; }, [](int&&) {});
+    EXPECT_EQ(calls_after_end, 0) << "run " << run;
+  }
+}
+
 /// What ran, in the order it ran, from any thread.
 class EventLog {
  public:
