@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "eval_stereo.hpp"
+#include "eval_truth.hpp"
 #include "options.hpp"
 #include "outputs.hpp"
 #include "sg/core/error.hpp"
@@ -40,6 +41,10 @@ struct EvalArgs {
   double gt_scale = 0;
   std::string matchers = "bm,sgbm,fast,fast-census";
   int drop_every = 0;  ///< drop every n-th frame (5 = 20 %), 0 = none
+  // --truth: a recording against a truth log; --baseline-method: a baseline instead.
+  std::string truth, distance_column, baseline;
+  std::optional<double> due_within_m;
+  std::optional<std::string> quiet_phases;
 };
 
 /// Two images and the forward GT flow from the first to the second.
@@ -196,6 +201,24 @@ void eval_main(const EvalArgs& args) {
   InputOptions input = args.input;
   input.spec.left = args.left;  // --left/--right are shared with --flow
   input.spec.right = args.right;
+  if (!args.truth.empty() || !args.baseline.empty()) {
+    TruthEvalArgs t;
+    t.input = input;
+    t.detector = args.detector;
+    t.outputs = args.outputs;
+    t.quiet = args.quiet;
+    t.json = args.json;
+    t.drop_every = args.drop_every;
+    t.truth = args.truth;
+    t.distance_column = args.distance_column;
+    t.due_within_m = args.due_within_m;
+    t.quiet_phases = args.quiet_phases;
+    t.baseline = args.baseline;
+    eval_truth_main(t);
+    return;
+  }
+  if (args.due_within_m || args.quiet_phases || !args.distance_column.empty())
+    throw core::InputError("--due-within, --quiet-phases and --distance-column need --truth FILE");
   OpenedInput in = open_input(input, args.detector.config);
   io::RunSettings settings;
   pipeline::RunOptions options = make_run_options(args.detector, input_platform(in), &settings);
@@ -213,8 +236,8 @@ void eval_main(const EvalArgs& args) {
     io::FolderSource* folder = in.folder;
     if (folder == nullptr) {
       throw core::InputError(in.name +
-                             " has no ground truth: eval scores a scenario or a stereo folder with "
-                             "gt/ (use run on recordings and cameras)");
+                             " has no ground truth: eval scores a scenario, a stereo folder with "
+                             "gt/, or a recording with --truth FILE (a truth log)");
     }
     if (!folder->has_truth()) {
       throw core::InputError(in.name + " has no ground truth (gt/frames.jsonl)");
@@ -258,7 +281,9 @@ void eval_main(const EvalArgs& args) {
 void add_eval_command(CLI::App& app) {
   auto args = std::make_shared<EvalArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "eval", "score detections against ground truth (a scenario, or a stereo folder with gt/)");
+      "eval",
+      "score detections against ground truth (a scenario, a stereo folder with gt/, or a "
+      "recording with --truth)");
   add_input_options(*cmd, args->input, false);
   add_detector_options(*cmd, args->detector);
   cmd->add_option("--json", args->json, "write the metrics as JSON");
@@ -267,8 +292,26 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--drop-every", args->drop_every,
                   "lose every n-th frame before the pipeline, as a loaded camera link does "
                   "(5 = 20 %; default 0 = none)");
+  auto* truth_option = cmd->add_option(
+      "--truth", args->truth,
+      "score a recording (any input) against a truth log: CSV with frame and/or t_s, a distance "
+      "(distance_m or board_distance_m) and/or phase; see docs/real-recordings.md");
+  cmd->add_option("--distance-column", args->distance_column,
+                  "with --truth: the log's distance column (default distance_m, else "
+                  "board_distance_m)");
+  cmd->add_option("--due-within", args->due_within_m,
+                  "with --truth: due frames = not quiet and truth distance <= M metres (default: "
+                  "truth TTC within the horizon)");
+  cmd->add_option("--quiet-phases", args->quiet_phases,
+                  "with --truth: phases whose frames are quiet, comma-separated (default "
+                  "still,creep,retreat,quiet,static,stop)");
+  auto* baseline_option = cmd->add_option(
+      "--baseline-method", args->baseline,
+      "run a baseline instead of the detector: central-median (StereoSGBM, median distance of "
+      "the central quarter); without --truth only its alarms are counted");
   auto* flow_flag = cmd->add_flag("--flow", args->flow,
                 "optical-flow accuracy instead: EPE and bad-3px % against a forward GT .flo");
+  flow_flag->excludes(truth_option)->excludes(baseline_option);
   cmd->add_option("--left", args->left,
                   "left video, image folder or glob; with --flow: first image (frame 1)");
   cmd->add_option("--right", args->right,
@@ -281,7 +324,9 @@ void add_eval_command(CLI::App& app) {
   cmd->add_flag("--stereo", args->stereo,
                 "stereo accuracy instead: bad-1/2/4 %, MAE, density per matcher against GT "
                 "disparity (--dir DATASET, or --left/--right/--gt)")
-      ->excludes(flow_flag);
+      ->excludes(flow_flag)
+      ->excludes(truth_option)
+      ->excludes(baseline_option);
   cmd->add_option("--gt-scale", args->gt_scale,
                   "with --stereo: 8-bit GT PNG scale, disparity = value / scale (default 0 = "
                   "from the folder's datasets.xml)");
