@@ -5,7 +5,7 @@
 # alarm frames are counted).
 # Usage: [SG_BIN=path/to/stereoguard] scripts/eval_real.sh [SHARED_DATA_DIR]
 # SHARED_DATA_DIR defaults to ../shared/data beside the repository; SG_BIN to build/release/stereoguard.
-# About two minutes on 2 cores.
+# About 40 s on 2 idle cores.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 data="${1:-$repo/../shared/data}"
