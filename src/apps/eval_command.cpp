@@ -221,7 +221,8 @@ void eval_main(const EvalArgs& args) {
     throw core::InputError("--due-within, --quiet-phases and --distance-column need --truth FILE");
   OpenedInput in = open_input(input, args.detector.config);
   io::RunSettings settings;
-  pipeline::RunOptions options = make_run_options(args.detector, input_platform(in), &settings);
+  pipeline::RunOptions options = make_run_options(args.detector, input_platform(in), &settings,
+                                                  &in.source->camera());
   const ResolvedOutputs outputs = resolve_outputs(args.outputs, settings);
   if (outputs.scale != 1.0) {
     throw core::InputError("scale: eval does not rescale the ground truth; use scale only with run");

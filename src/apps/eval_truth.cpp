@@ -72,7 +72,8 @@ void eval_truth_main(const TruthEvalArgs& args) {
   }
   OpenedInput in = open_input(args.input, args.detector.config);
   io::RunSettings settings;
-  pipeline::RunOptions options = make_run_options(args.detector, input_platform(in), &settings);
+  pipeline::RunOptions options =
+      make_run_options(args.detector, input_platform(in), &settings, &in.source->camera());
   const ResolvedOutputs outputs = resolve_outputs(args.outputs, settings);
   if (outputs.scale != 1.0)
     throw core::InputError("scale: eval does not rescale its input; use scale only with run");

@@ -149,9 +149,45 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                "split optical flow into the T tiles too (faster, not bit-identical)");
 }
 
+namespace {
+
+/// The camera-derived defaults (core::adapt_to_camera) for the envelope and settings the config
+/// file will give, written into `params` before the file and the flags, which still override them.
+void fit_to_camera(const std::string& config, const core::Camera& camera,
+                   core::DetectorParams& params) {
+  core::DetectorParams derived = params;
+  if (!config.empty()) {
+    io::RunSettings ignored;
+    io::apply_config_file(config, derived, ignored);
+  }
+  core::adapt_to_camera(derived, camera);
+  params.bm.num_disparities = derived.bm.num_disparities;
+  params.signal.min_area_px = derived.signal.min_area_px;
+  params.signal.region_min_px = derived.signal.region_min_px;
+  params.scene_flow.edge_margin_px = derived.scene_flow.edge_margin_px;
+  params.stereo.gaps = derived.stereo.gaps;
+  params.scene_flow.gaps = derived.scene_flow.gaps;
+}
+
+}  // namespace
+
+core::CameraFit camera_fit(const pipeline::RunOptions& options, const core::Camera& camera) {
+  core::DetectorParams derived = options.params;
+  const core::CameraFit wanted = core::adapt_to_camera(derived, camera);
+  core::CameraFit fit = core::depth_range(options.params, camera);
+  if (options.params.bm.num_disparities == derived.bm.num_disparities) fit.warning = wanted.warning;
+  return fit;
+}
+
+std::string format_metres(double m) {
+  char text[32];
+  std::snprintf(text, sizeof text, m < 10.0 ? "%.2f" : "%.0f", m);
+  return text;
+}
+
 pipeline::RunOptions make_run_options(const DetectorOptions& o,
                                       const std::string& default_platform,
-                                      io::RunSettings* settings_out) {
+                                      io::RunSettings* settings_out, const core::Camera* camera) {
   pipeline::RunOptions run;
   io::RunSettings settings;
   std::string platform = default_platform;
@@ -163,6 +199,7 @@ pipeline::RunOptions make_run_options(const DetectorOptions& o,
   // run and eval recommend Stereo-Flow: Stereo mode alarms on whatever passes by (crossing,
   // ego-pass, turning). A config file's detector.mode or --mode picks the other.
   run.params.mode = core::Mode::kStereoFlow;
+  if (camera) fit_to_camera(o.config, *camera, run.params);
   if (!o.config.empty()) io::apply_config_file(o.config, run.params, settings);
   if (settings_out) *settings_out = settings;
   run.pace_fps = settings.pace_fps;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "sg/core/params.hpp"
+#include "sg/core/platform.hpp"
 #include "sg/core/source.hpp"
 #include "sg/io/config.hpp"
 #include "sg/io/source_factory.hpp"
@@ -64,9 +65,17 @@ void add_detector_options(CLI::App& app, DetectorOptions& options);
 /// `default_platform`, e.g. the scenario's), then the config file, then the flags. Not validated
 /// here (pipeline::run does). `settings`, when given, receives the config file's run settings
 /// (outputs, scale).
+/// With `camera`, the defaults that depend on it (core::adapt_to_camera: disparity range, pixel
+/// sizes, frame gaps) come after the platform preset, before the config file and the flags.
 pipeline::RunOptions make_run_options(const DetectorOptions& options,
                                       const std::string& default_platform = "",
-                                      io::RunSettings* settings = nullptr);
+                                      io::RunSettings* settings = nullptr,
+                                      const core::Camera* camera = nullptr);
+/// The depth range `options` measure with `camera`, and the warning of a disparity range capped
+/// short of the contact plane (only when the range is the derived one, not the user's).
+core::CameraFit camera_fit(const pipeline::RunOptions& options, const core::Camera& camera);
+/// A distance for a person to read: "0.47" below 10 m, "20" from there.
+std::string format_metres(double m);
 /// The platform a scenario input is made for ("" for a folder or a scenario without one).
 std::string input_platform(const OpenedInput& input);
 

@@ -69,11 +69,13 @@ class WarningPrinter {
 void run_main(const RunArgs& args) {
   OpenedInput in = open_input(args.input, args.detector.config);
   io::RunSettings settings;
-  pipeline::RunOptions options = make_run_options(args.detector, input_platform(in), &settings);
+  make_run_options(args.detector, input_platform(in), &settings);
   const ResolvedOutputs outputs = resolve_outputs(args.outputs, settings);
-  options.keep_maps = !outputs.dump.empty();
   in.source = io::scale_source(std::move(in.source), outputs.scale);
   const core::Camera& cam = in.source->camera();
+  pipeline::RunOptions options =
+      make_run_options(args.detector, input_platform(in), &settings, &cam);
+  options.keep_maps = !outputs.dump.empty();
   core::throw_if_invalid(pipeline::validate(options, cam), "invalid parameters");
 
   std::string overlay = args.overlay;
@@ -92,9 +94,12 @@ void run_main(const RunArgs& args) {
   std::optional<io::OverlayWriter> video;
   if (!overlay.empty()) video.emplace(overlay_partial, cv::Size(cam.width, cam.height), cam.fps);
 
+  const core::CameraFit range = camera_fit(options, cam);
   std::cout << "stereoguard run: " << in.name << ", " << cam.width << "x" << cam.height << ", "
             << (in.source->size() >= 0 ? std::to_string(in.source->size()) + " frames, " : "")
-            << "mode " << core::to_string(options.params.mode) << "\n";
+            << "mode " << core::to_string(options.params.mode) << ", depth "
+            << format_metres(range.near_m) << "-" << format_metres(range.far_m) << " m\n";
+  if (!range.warning.empty()) std::cout << "warning: " << range.warning << "\n";
   WarningPrinter printer;
   std::ostringstream warning;
   pipeline::RunSummary summary;

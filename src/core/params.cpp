@@ -174,6 +174,7 @@ std::vector<std::string> validate(const SignalParams& p) {
             "ttc_fit_min_span_s", p.ttc_fit_min_span_s, "must be in [0, ttc_fit_window_s]");
   c.require(p.severity_off_frames >= 1, "severity_off_frames", p.severity_off_frames,
             "must be >= 1");
+  c.require(p.confirm_frames >= 1, "confirm_frames", p.confirm_frames, "must be >= 1");
   return out;
 }
 

@@ -1,5 +1,9 @@
 #include "sg/core/platform.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
 #include "sg/core/error.hpp"
 
 namespace sg::core {
@@ -64,6 +68,76 @@ void apply_platform(const std::string& name, DetectorParams& params) {
   params.stereo.z_max_m = p.stereo_z_max_m;
   params.scene_flow.z_max_m = p.scene_flow_z_max_m;
   params.scene_flow.ground.z_max_m = p.ground_z_max_m;
+}
+
+}  // namespace sg::core
+
+namespace sg::core {
+namespace {
+
+/// Gaps of `gaps` frames at kReferenceFps, as frames at `fps`: the same spans, at least 1 frame,
+/// each once, in increasing order.
+std::vector<int> gaps_at(const std::vector<int>& gaps, double fps) {
+  std::vector<int> out;
+  for (int k : gaps) out.push_back(std::max(1, static_cast<int>(std::lround(k * fps / kReferenceFps))));
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+/// The smallest area a blob can have and still be an obstacle, px, whatever the image size:
+/// below it a blob is a few matching windows wide, a mismatch as likely as a surface.
+constexpr int kMinAreaFloorPx = 16;
+
+int scaled_area(int area_px, double area_ratio) {
+  return std::max(kMinAreaFloorPx, static_cast<int>(std::lround(area_px * area_ratio)));
+}
+
+}  // namespace
+
+CameraFit depth_range(const DetectorParams& params, const Camera& camera) {
+  CameraFit fit;
+  const int top = params.bm.min_disparity + params.bm.num_disparities - 1;
+  fit.near_m = top > 0 ? camera.depth(top) : 0.0;
+  fit.far_m = params.mode == Mode::kStereo ? params.stereo.z_max_m : params.scene_flow.z_max_m;
+  return fit;
+}
+
+CameraFit adapt_to_camera(DetectorParams& params, const Camera& camera) {
+  // The range: the matcher measures disparities min_disparity .. min_disparity + range - 1.
+  const double fb = camera.focal_px * camera.baseline_m;
+  const double needed = fb / params.envelope.z_contact_m - params.bm.min_disparity + 1.0;
+  const int wanted = std::max(16, static_cast<int>(std::ceil(needed / 16.0 - 1e-9)) * 16);
+  const int width_cap = std::max(16, (camera.width / 2) / 16 * 16);
+  const int cap = std::min(kMaxDerivedDisparities, width_cap);
+  params.bm.num_disparities = std::min(wanted, cap);
+
+  const double area_ratio = static_cast<double>(camera.width) * camera.height /
+                            (static_cast<double>(kReferenceWidth) * kReferenceHeight);
+  params.signal.min_area_px = scaled_area(params.signal.min_area_px, area_ratio);
+  params.signal.region_min_px = scaled_area(params.signal.region_min_px, area_ratio);
+  // The margin covers the block's fattening of the foreground (half a block) and the flow's
+  // bleeding over edges, which shrinks with the image; it never grows past the default.
+  const int margin = static_cast<int>(
+      std::lround(params.scene_flow.edge_margin_px * static_cast<double>(camera.width) /
+                  kReferenceWidth));
+  params.scene_flow.edge_margin_px = std::clamp(margin, std::min(params.bm.block_size / 2,
+                                                                 params.scene_flow.edge_margin_px),
+                                                params.scene_flow.edge_margin_px);
+
+  params.stereo.gaps = gaps_at(params.stereo.gaps, camera.fps);
+  params.scene_flow.gaps = gaps_at(params.scene_flow.gaps, camera.fps);
+
+  CameraFit fit = depth_range(params, camera);
+  if (wanted > cap) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "the disparity range is capped at %d px: nothing nearer than %.2f m is measured "
+                  "(contact at %.2f m needs %d px)",
+                  cap, fit.near_m, params.envelope.z_contact_m, wanted);
+    fit.warning = line;
+  }
+  return fit;
 }
 
 }  // namespace sg::core

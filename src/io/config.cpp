@@ -166,6 +166,7 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("ttc_fit_min_span_s", p.signal.ttc_fit_min_span_s)
         .field("coast_near_range", p.signal.coast_near_range)
         .field("severity_off_frames", p.signal.severity_off_frames)
+        .field("confirm_frames", p.signal.confirm_frames)
         .done();
     std::string method = core::to_string(p.flow.method);
     Section(root["flow"], "flow")

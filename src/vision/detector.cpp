@@ -85,7 +85,8 @@ Detector::Detector(const core::DetectorParams& params, const core::Camera& camer
       camera_(camera),
       hysteresis_(params.signal),
       tracker_(params.signal, params.envelope.z_contact_m,
-               camera.focal_px * camera.baseline_m / std::max(1, params.bm.num_disparities - 1)),
+               camera.focal_px * camera.baseline_m / std::max(1, params.bm.num_disparities - 1),
+               camera.focal_px * camera.baseline_m),
       severity_(params.signal) {
   if (!core::is_surveyed(params_.mode)) {
     const std::vector<int>& gaps =
@@ -250,7 +251,8 @@ void LabelJob::conclude() {
     danger_.setTo(0, ground);
     ttc_.setTo(std::numeric_limits<float>::quiet_NaN(), ground);
   }
-  obstacles_ = extract_obstacles(danger_, disparity_, ttc_, *camera_, p.signal, velocity_);
+  obstacles_ =
+      extract_obstacles(danger_, disparity_, ttc_, *camera_, p.signal, velocity_, &obstacle_runs_);
   region_pixels_ = count_region_pixels(danger_, p.signal.region_columns);
   concluded_ = true;
 }
@@ -263,6 +265,22 @@ core::Detection Detector::finish(const core::StereoFrame& frame, LabelJob& job) 
   det.danger = job.danger_;
   det.obstacles = std::move(job.obstacles_);
   tracker_.update(det.time_s, det.obstacles);
+  // A blob whose track is not confirmed yet raises nothing: off the mask, out of the list.
+  std::vector<bool> confirmed(det.obstacles.size(), true);
+  bool any_unconfirmed = false;
+  for (size_t i = 0; i < det.obstacles.size(); ++i) {
+    const core::Obstacle& o = det.obstacles[i];
+    confirmed[i] = o.predicted || o.seen_frames >= params_.signal.confirm_frames;
+    any_unconfirmed = any_unconfirmed || !confirmed[i];
+  }
+  if (any_unconfirmed) {
+    if (clear_obstacles(det.danger, job.obstacle_runs_, confirmed))
+      job.region_pixels_ = count_region_pixels(det.danger, params_.signal.region_columns);
+    std::vector<core::Obstacle> kept;
+    for (size_t i = 0; i < det.obstacles.size(); ++i)
+      if (confirmed[i]) kept.push_back(std::move(det.obstacles[i]));
+    det.obstacles = std::move(kept);
+  }
   // An obstacle kept by prediction after its blob vanished nearer than the matcher sees is
   // dangerous where it was last seen.
   bool painted = false;

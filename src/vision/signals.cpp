@@ -34,7 +34,8 @@ double median_depth(const std::vector<float>& disparities, const core::Camera& c
 std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp,
                                               const cv::Mat& ttc, const core::Camera& camera,
                                               const core::SignalParams& p,
-                                              const cv::Mat& velocity) {
+                                              const cv::Mat& velocity,
+                                              std::vector<ObstacleRun>* obstacle_runs) {
   const bool with_velocity = !velocity.empty();
   if (with_velocity && (velocity.type() != CV_32FC3 || velocity.size() != mask.size()))
     throw core::InputError("obstacles: the velocity map must be CV_32FC3 of the mask's size");
@@ -79,8 +80,10 @@ std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp
 
   // Labels are numbered in the raster order of the blobs' first pixels.
   std::vector<core::Obstacle> out;
+  std::vector<int> index_of(static_cast<size_t>(count), -1);
   for (int l = 1; l < count; ++l) {
     if (!kept_blob[static_cast<size_t>(l)]) continue;
+    index_of[static_cast<size_t>(l)] = static_cast<int>(out.size());
     Blob& b = blobs[static_cast<size_t>(l)];
     core::Obstacle o;
     o.bbox = stats[static_cast<size_t>(l)].bbox;
@@ -90,7 +93,25 @@ std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp
     if (b.velocity_count > 0) o.velocity = b.velocity_sum * (1.0 / b.velocity_count);
     out.push_back(o);
   }
+  if (obstacle_runs) {
+    obstacle_runs->clear();
+    for (const ComponentRun& run : runs)
+      if (kept_blob[static_cast<size_t>(run.label)])
+        obstacle_runs->push_back({run.y, run.x0, run.x1, index_of[static_cast<size_t>(run.label)]});
+  }
   return out;
+}
+
+bool clear_obstacles(cv::Mat& mask, const std::vector<ObstacleRun>& runs,
+                     const std::vector<bool>& keep) {
+  bool cleared = false;
+  for (const ObstacleRun& run : runs) {
+    if (keep[static_cast<size_t>(run.obstacle)]) continue;
+    uchar* m = mask.ptr<uchar>(run.y);
+    std::fill(m + run.x0, m + run.x1, 0);
+    cleared = true;
+  }
+  return cleared;
 }
 
 std::vector<std::string> region_names(int columns) {

@@ -370,6 +370,7 @@ void MatchRowsT(D16 d16, const FastJob& j) {
   const int ncols = j.width - xb, nout = x1 - x0;
   std::uint16_t* HWY_RESTRICT v = j.v;
   std::vector<int> best(nout);
+  std::vector<std::uint32_t> rkey(j.lr_max_diff >= 0 ? static_cast<size_t>(j.width) : 0);
   std::fill(v, v + static_cast<size_t>(ncols) * nd, std::uint16_t{0});
   for (int row = 0; row < 2 * h + 1; ++row) {
     const RowPtrs ra = RowAt(j, row);
@@ -383,25 +384,27 @@ void MatchRowsT(D16 d16, const FastJob& j) {
     else
       MatchRow<kCensus, false, kNV>(d16, j, y, best.data());
     if (j.lr_max_diff >= 0) {
-      // Right image's winners: right pixel xr is seen by left pixel xr + min_disp + d at d.
+      // Right image's winners: right pixel xr is seen by left pixel xr + min_disp + d at d; the
+      // least cost wins, the smaller d on a tie, i.e. the least key (cost << 16 | d). For one left
+      // pixel the keys of d = nd - 1 .. 0 fall on consecutive right pixels: a contiguous
+      // element-wise min the compiler vectorises (the nested branchy loop cost 6.8 ms a frame).
       const std::uint16_t* s = j.s;
       std::int16_t* out = j.out + static_cast<size_t>(y - j.y_begin) * j.out_step;
-      std::vector<int> rbest(j.width, -1), rcost(j.width, INT_MAX);
+      std::fill(rkey.begin(), rkey.end(), UINT32_MAX);
       for (int i = 0; i < nout; ++i) {
         const std::uint16_t* c = s + static_cast<size_t>(i) * nd;
-        const int x = x0 + i;
-        for (int d = 0; d < nd; ++d) {
-          const int xr = x - j.min_disp - d;
-          if (c[d] < rcost[xr] || (c[d] == rcost[xr] && d < rbest[xr])) {
-            rcost[xr] = c[d];
-            rbest[xr] = d;
-          }
+        std::uint32_t* r = rkey.data() + (x0 + i - j.min_disp - (nd - 1));  // r[k]: d = nd-1-k
+        for (int k = 0; k < nd; ++k) {
+          const int d = nd - 1 - k;
+          const std::uint32_t key = (std::uint32_t{c[d]} << 16) | static_cast<std::uint32_t>(d);
+          r[k] = std::min(r[k], key);
         }
       }
       for (int i = 0; i < nout; ++i) {
         if (out[x0 + i] == kInvalid16) continue;
         const int xr = x0 + i - j.min_disp - best[i];
-        if (std::abs(rbest[xr] - best[i]) > j.lr_max_diff) out[x0 + i] = kInvalid16;
+        const int rbest = static_cast<int>(rkey[static_cast<size_t>(xr)] & 0xFFFFu);
+        if (std::abs(rbest - best[i]) > j.lr_max_diff) out[x0 + i] = kInvalid16;
       }
     }
   }

@@ -1,6 +1,7 @@
 #include "sg/vision/tracking.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <tuple>
 
 namespace sg::vision {
@@ -32,8 +33,19 @@ bool fit_line(const std::vector<double>& t, const std::vector<double>& z, double
 }
 
 ObstacleTracker::ObstacleTracker(const core::SignalParams& p, double z_contact_m,
-                                 double z_near_limit_m)
-    : p_(p), z_contact_m_(z_contact_m), z_near_limit_m_(z_near_limit_m) {}
+                                 double z_near_limit_m, double focal_baseline)
+    : p_(p),
+      z_contact_m_(z_contact_m),
+      z_near_limit_m_(z_near_limit_m),
+      focal_baseline_(focal_baseline) {}
+
+bool ObstacleTracker::holds_together(double z_last, double z_now, double v_z, double dt) const {
+  if (!(focal_baseline_ > 0.0)) return true;
+  const double moved = v_z * dt;
+  const double matching = (z_last * z_last + z_now * z_now) / focal_baseline_;
+  const double tolerance = 0.1 * z_now + 0.25 * std::abs(moved) + 2.0 * matching;
+  return std::abs(z_now - (z_last + moved)) <= tolerance;
+}
 
 bool ObstacleTracker::out_of_reach(const Track& track, double time_s) const {
   double z_now = 0;
@@ -96,6 +108,15 @@ void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacl
     const cv::Rect last_bbox = track.bbox;
     track.bbox = o.bbox;
     o.track_id = track.id;
+    track.seen = track_of[j] >= 0 ? track.seen + 1 : 1;
+    if (o.distance_m > 0) {
+      if (track.last_z > 0 && o.velocity &&
+          !holds_together(track.last_z, o.distance_m, (*o.velocity)[2], time_s - track.last_t))
+        track.seen = 1;
+      track.last_t = time_s;
+      track.last_z = o.distance_m;
+    }
+    o.seen_frames = track.seen;
     // A blob measured nearer than the margin has a disparity at the top of the search range,
     // saturated or aliased: it does not enter the fit either.
     const bool measured_near = p_.coast_near_range && o.distance_m > 0 &&
@@ -146,6 +167,7 @@ void ObstacleTracker::update(double time_s, std::vector<core::Obstacle>& obstacl
     o.bbox = track.bbox;
     o.track_id = track.id;
     o.predicted = true;
+    o.seen_frames = ++track.seen;
     obstacles.push_back(o);
     next.push_back(std::move(track));
   }

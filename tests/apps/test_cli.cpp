@@ -263,14 +263,22 @@ TEST_F(Cli, ScenarioPlatformIsAppliedUnlessAFlagOrConfigSaysOtherwise) {
       << "name: narrow\nframes: 3\nplatform: car\n"
       << "camera: {width: 120, height: 90, focal_px: 100, cx: 60, cy: 45}\n"
       << "obstacles:\n  - {id: 1, size_m: [1, 1, 1], position_m: [0, 0.7, 6]}\n";
-  expect_user_error(run("eval --scenario narrow.yaml"), "num_disparities=128");
-  EXPECT_EQ(run("eval --scenario narrow.yaml --platform robot").status, 0);
+  // The range comes from the camera and the preset's contact plane (f B = 12 px m: 16 px reach
+  // 0.8 m, beyond the robot's 0.5 m contact, so 32; the car's 2 m need 16); the first line of run
+  // names the depth it measures.
+  const auto first_line = [&](const std::string& args) {
+    const Result r = run("run --scenario narrow.yaml --quiet " + args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return r.out.substr(0, r.out.find('\n'));
+  };
+  EXPECT_NE(first_line("").find("depth 0.80-60 m"), std::string::npos) << first_line("");
+  EXPECT_NE(first_line("--platform robot").find("depth 0.39-20 m"), std::string::npos);
   std::ofstream(dir_ / "robot.yaml") << "platform: robot\n";
-  EXPECT_EQ(run("eval --scenario narrow.yaml --config robot.yaml").status, 0);
+  EXPECT_NE(first_line("--config robot.yaml").find("depth 0.39-20 m"), std::string::npos);
   std::ofstream(dir_ / "car.yaml") << "platform: car\n";
   expect_user_error(run("eval --scenario narrow.yaml --config car.yaml --platform walker "
                         "--num-disparities 256"),
-                    "num_disparities=256");  // flags still override the preset
+                    "num_disparities=256");  // flags still override the preset and the camera
 }
 
 // run and eval default to Stereo-Flow (the mode we recommend); a config file or --mode picks

@@ -53,5 +53,83 @@ TEST(Platform, UnknownNameListsTheKnownOnes) {
   }
 }
 
+TEST(AdaptToCamera, TheRangeReachesTheContactPlane) {
+  // The shared robot recording: f B = 567.2 px x 0.0922 m = 52.3 px m; contact at 0.5 m needs
+  // a disparity of 104.6 px, so 7 x 16 = 112 (64 measured only down to 0.83 m).
+  Camera robot;
+  robot.focal_px = 567.2;
+  robot.baseline_m = 0.092226;
+  robot.fps = 15.0;
+  DetectorParams p;
+  const CameraFit fit = adapt_to_camera(p, robot);
+  EXPECT_EQ(p.bm.num_disparities, 112);
+  EXPECT_LE(fit.near_m, p.envelope.z_contact_m);
+  EXPECT_GT(robot.depth(p.bm.num_disparities - 17), p.envelope.z_contact_m);  // 96 is too few
+  EXPECT_TRUE(fit.warning.empty());
+  EXPECT_TRUE(validate(p, robot).empty());
+  // A tiny board (f B = 7.1 px m): 16 disparities reach 0.47 m.
+  Camera board;
+  board.width = 122;
+  board.height = 94;
+  board.focal_px = 118.0;
+  board.baseline_m = 0.06;
+  board.fps = 6.9;
+  DetectorParams q;
+  adapt_to_camera(q, board);
+  EXPECT_EQ(q.bm.num_disparities, 16);
+  EXPECT_TRUE(validate(q, board).empty());
+}
+
+TEST(AdaptToCamera, ACappedRangeSaysWhatItCannotMeasure) {
+  Camera wide_baseline;
+  wide_baseline.baseline_m = 0.5;  // f B = 250 px m: 500 px for 0.5 m
+  DetectorParams p;
+  const CameraFit fit = adapt_to_camera(p, wide_baseline);
+  EXPECT_EQ(p.bm.num_disparities, kMaxDerivedDisparities);
+  EXPECT_NEAR(fit.near_m, 250.0 / (kMaxDerivedDisparities - 1), 1e-9);
+  EXPECT_NE(fit.warning.find("0.98 m"), std::string::npos) << fit.warning;
+  // Below the image width too: a 200 px wide image gets at most 96.
+  Camera narrow = wide_baseline;
+  narrow.width = 200;
+  DetectorParams q;
+  adapt_to_camera(q, narrow);
+  EXPECT_EQ(q.bm.num_disparities, 96);
+  EXPECT_TRUE(validate(q, narrow).empty());
+}
+
+TEST(AdaptToCamera, SizesScaleWithTheImageAndGapsKeepTheirSeconds) {
+  const DetectorParams defaults;
+  Camera reference;  // 640x480 at 30 fps: pixel sizes and gaps as written
+  DetectorParams p;
+  adapt_to_camera(p, reference);
+  EXPECT_EQ(p.signal.min_area_px, defaults.signal.min_area_px);
+  EXPECT_EQ(p.signal.region_min_px, defaults.signal.region_min_px);
+  EXPECT_EQ(p.scene_flow.edge_margin_px, defaults.scene_flow.edge_margin_px);
+  EXPECT_EQ(p.scene_flow.gaps, defaults.scene_flow.gaps);
+  EXPECT_EQ(p.stereo.gaps, defaults.stereo.gaps);
+
+  Camera big = reference;  // 4x the pixels at 60 fps
+  big.width = 1280;
+  big.height = 960;
+  big.fps = 60.0;
+  DetectorParams q;
+  adapt_to_camera(q, big);
+  EXPECT_EQ(q.signal.min_area_px, 4 * defaults.signal.min_area_px);
+  EXPECT_EQ(q.scene_flow.edge_margin_px, defaults.scene_flow.edge_margin_px);  // never grows
+  EXPECT_EQ(q.scene_flow.gaps, (std::vector<int>{2, 8, 20, 40}));
+
+  Camera small = reference;  // the 122x94 board at 6.9 fps
+  small.width = 122;
+  small.height = 94;
+  small.fps = 6.9;
+  DetectorParams r;
+  adapt_to_camera(r, small);
+  EXPECT_EQ(r.signal.min_area_px, 16);  // 150 x 0.037 = 5.6 px is below the floor
+  EXPECT_EQ(r.scene_flow.edge_margin_px, defaults.bm.block_size / 2);
+  EXPECT_EQ(r.scene_flow.gaps, (std::vector<int>{1, 2, 5}));  // 1, 0.9, 2.3, 4.6 frames
+  EXPECT_EQ(r.stereo.gaps, (std::vector<int>{1, 3}));         // 0.2, 1.2, 3.5 frames
+  EXPECT_TRUE(validate(r, small).empty());
+}
+
 }  // namespace
 }  // namespace sg::core

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -105,6 +106,7 @@ TEST(Detector, GapUsesTheFrameExactlyKFramesAgo) {
   params.stereo.gaps = {3};
   params.signal.on_k = 1;
   params.signal.on_n = 1;
+  params.signal.confirm_frames = 1;
   Detector det(params, camera());
   const core::Camera cam = camera();
   std::vector<core::Detection> out;
@@ -130,6 +132,7 @@ TEST(Detector, DroppedFramesStretchTheGapByTheirTime) {
   params.stereo.gaps = {1};
   params.signal.on_k = 1;
   params.signal.on_n = 1;
+  params.signal.confirm_frames = 1;
   Detector det(params, camera());
   const core::Camera cam = camera();
   core::Detection last;
@@ -155,12 +158,14 @@ core::DetectorParams flow_params() {
   return p;
 }
 
-/// Stereo-Flow with these gaps and a signal on from the first dangerous frame.
+/// Stereo-Flow with these gaps and a signal on from the first dangerous frame (no confirmation
+/// over frames either: the tests look at each frame's labelling).
 core::DetectorParams flow_params_at_once(std::vector<int> gaps) {
   core::DetectorParams p = flow_params();
   p.scene_flow.gaps = std::move(gaps);
   p.signal.on_k = 1;
   p.signal.on_n = 1;
+  p.signal.confirm_frames = 1;
   return p;
 }
 
@@ -189,9 +194,9 @@ TEST(DetectorStereoFlow, HeadOnPatchFiresWithItsVelocity) {
   EXPECT_EQ(cv::countNonZero(out[0].danger), 0);  // no history yet
   // The disparity grows by 0.36 px a frame, below min_delta_d_px. Frames 2 and 3 fit a chain short
   // of the longest gap: doubted by startup_doubt_px, their slowest plausible approach (1 m/s at
-  // frame 3) is too slow; from frame 4 the window is full (1.4 px over its span). With on_k = 2
-  // the signal is on from frame 5 to the end.
-  for (int i = 0; i < 16; ++i) EXPECT_EQ(out[i].signal, i >= 5) << "frame " << i;
+  // frame 3) is too slow; from frame 4 the window is full (1.4 px over its span). The blob is
+  // confirmed on its second frame (5), and with on_k = 2 the signal is on from frame 6 to the end.
+  for (int i = 0; i < 16; ++i) EXPECT_EQ(out[i].signal, i >= 6) << "frame " << i;
   const core::Detection& last = out[15];
   ASSERT_TRUE(last.signal);
   EXPECT_TRUE(last.regions[1].fired);
@@ -216,6 +221,9 @@ TEST(DetectorStereoFlow, HeadOnPatchFiresWithItsVelocity) {
 TEST(DetectorStereoFlow, CrossingPatchNeverFiresWhereStereoModeDoes) {
   core::DetectorParams stereo_params;
   stereo_params.stereo.gaps = {1};
+  // The thesis' Stereo mode: the leading edge moves by 6 px a frame, so confirmation over frames
+  // would drop its strips (a new box every frame); without it they fire.
+  stereo_params.signal.confirm_frames = 1;
   Detector flow_det(flow_params(), camera()), stereo_det(stereo_params, camera());
   cv::RNG rng(12);
   const core::Camera cam = camera();
@@ -359,6 +367,47 @@ TEST(FrameKernels, DisparityMatchesBmAndMismatchedFramesAreRejected) {
   EXPECT_EQ(cv::countNonZero(disp != whole), 0);
   f.right = pair.right(cv::Rect(0, 0, 200, 97));
   EXPECT_THROW(check_frame(f), core::InputError);
+}
+
+// Mismatch-like blobs: every other frame a patch 11 m away flashes up in front of a 20 m wall, at
+// one of two places in the centre region, so that no blob is seen twice in a row. Each frame with
+// a blob is dangerous by itself (Stereo mode: the disparity grew by 2 px within 0.1 s); the
+// region hysteresis alone (2 of 3 frames) lets them fire, while confirmation keeps them quiet
+// and still lets a patch that stays fire.
+TEST(Detector, BlobsSeenForOneFrameRaiseNoAlarm) {
+  const core::Camera cam = camera();
+  auto wall_with = [&cam](std::optional<cv::Rect> patch) {
+    cv::Mat d(cam.height, cam.width, CV_32F, cv::Scalar(cam.disparity(20.0)));
+    d(cv::Rect(0, 0, 20, cam.height)).setTo(-1.0f);
+    if (patch) d(*patch).setTo(cam.disparity(11.0));
+    return d;
+  };
+  const cv::Rect a(55, 52, 20, 17), b(85, 52, 20, 17);
+  auto flashes = [&](int confirm_frames) {
+    core::DetectorParams params;
+    params.mode = core::Mode::kStereo;
+    params.signal.confirm_frames = confirm_frames;
+    Detector det(params, cam);
+    int alarms = 0;
+    for (int i = 0; i < 16; ++i) {
+      std::optional<cv::Rect> patch;
+      if (i >= 6 && i % 2 == 0) patch = (i % 4 == 0) ? a : b;
+      alarms += det.process(frame(i), {wall_with(patch), {}}).signal ? 1 : 0;
+    }
+    return alarms;
+  };
+  EXPECT_GT(flashes(1), 0);  // what the test guards against
+  EXPECT_EQ(flashes(2), 0);
+
+  // A patch that stays and comes nearer fires (as in ApproachingPatchFiresAfterHysteresis...).
+  core::DetectorParams params;
+  params.mode = core::Mode::kStereo;
+  Detector det(params, cam);
+  cv::RNG rng(5);
+  int alarms = 0;
+  for (int i = 0; i < 16; ++i)
+    alarms += det.process(frame(i), {scene(8.0 - 0.25 * i, rng, 0.1), {}}).signal ? 1 : 0;
+  EXPECT_GE(alarms, 8);
 }
 
 }  // namespace

@@ -223,5 +223,68 @@ TEST(SeverityHold, RisesAtOnceFallsAfterItsFrames) {
   EXPECT_EQ(hold.update(false, S::kNone), S::kNone);
 }
 
+// seen_frames counts the consecutive frames of a track: a blob seen once has 1, the same box in
+// the next frame 2; a gap of one frame ends the track, so a blob that comes back starts at 1.
+TEST(ObstacleTracker, SeenFramesCountsConsecutiveFramesOnly) {
+  core::SignalParams p;
+  ObstacleTracker tracker(p, 0.5, 0.0, 60.0);
+  const cv::Rect box(100, 100, 40, 40);
+  std::vector<int> seen;
+  for (int i = 0; i < 6; ++i) {
+    std::vector<core::Obstacle> obs;
+    if (i != 3) obs.push_back(box_at(box, 5.0 - 0.1 * i, 2.0));
+    tracker.update(i / 30.0, obs);
+    seen.push_back(obs.empty() ? 0 : obs[0].seen_frames);
+  }
+  EXPECT_EQ(seen, (std::vector<int>{1, 2, 3, 0, 1, 2}));
+}
+
+// A mismatch read at a fixed wrong depth while its flow says it moves fast (the overhead
+// recording: 0.54 m, the top of the range, at 3.7 m/s) never holds together; a box that comes
+// nearer as fast as its velocity says does, through 10 % of depth noise.
+TEST(ObstacleTracker, ADistanceThatDisagreesWithItsVelocityRestartsTheCount) {
+  core::SignalParams p;
+  const double fb = 30.0;  // f B, px m
+  ObstacleTracker tracker(p, 0.5, fb / 63.0, fb);
+  const double dt = 1.0 / 20.0;
+  const cv::Rect mismatch(50, 300, 15, 12), box(300, 200, 80, 80);
+  int max_mismatch = 0, last_box = 0;
+  for (int i = 0; i < 10; ++i) {
+    core::Obstacle m = box_at(mismatch, 0.54, 0.0);
+    m.velocity = cv::Vec3d(0.0, 0.0, -3.7);
+    const double z = 3.0 - 1.0 * i * dt;
+    core::Obstacle b = box_at(box, z * (i % 2 ? 1.04 : 0.96), 2.0);
+    b.velocity = cv::Vec3d(0.0, 0.0, -1.0);
+    std::vector<core::Obstacle> obs{m, b};
+    tracker.update(i * dt, obs);
+    max_mismatch = std::max(max_mismatch, obs[0].seen_frames);
+    last_box = obs[1].seen_frames;
+  }
+  EXPECT_EQ(max_mismatch, 1);
+  EXPECT_EQ(last_box, 10);
+  // Without a velocity (Stereo mode) only the frames count.
+  ObstacleTracker plain(p, 0.5, fb / 63.0, fb);
+  int seen = 0;
+  for (int i = 0; i < 3; ++i) {
+    std::vector<core::Obstacle> obs{box_at(mismatch, 0.54, 0.0)};
+    plain.update(i * dt, obs);
+    seen = obs[0].seen_frames;
+  }
+  EXPECT_EQ(seen, 3);
+}
+
+TEST(ObstacleTracker, HoldsTogetherToleratesTheMatchersErrorAndNoMore) {
+  core::SignalParams p;
+  ObstacleTracker tracker(p, 0.5, 0.0, 52.3);
+  // 1 m, still: 0.1 m of extent change plus 2 x 2/52.3 m of matching error.
+  EXPECT_TRUE(tracker.holds_together(1.0, 1.15, 0.0, 0.0667));
+  EXPECT_FALSE(tracker.holds_together(1.0, 1.3, 0.0, 0.0667));
+  // Approaching at 0.3 m/s over a frame: 2 cm nearer is expected, not a violation.
+  EXPECT_TRUE(tracker.holds_together(1.0, 0.98, -0.3, 0.0667));
+  // Without f B there is no test.
+  ObstacleTracker untested(p, 0.5);
+  EXPECT_TRUE(untested.holds_together(1.0, 5.0, -3.0, 0.05));
+}
+
 }  // namespace
 }  // namespace sg::vision

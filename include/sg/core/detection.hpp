@@ -28,6 +28,10 @@ struct Obstacle {
   std::optional<double> ttc_s;         ///< median time to contact, s
   std::optional<cv::Vec3d> velocity;   ///< mean 3D velocity relative to the camera, m/s (Stereo-Flow)
   int track_id = 0;                    ///< the same obstacle keeps its id across frames; 0 = untracked
+  /// Consecutive frames its track has been seen in with a distance that agrees with its motion,
+  /// this one included (vision/tracking.hpp); 0 = untracked. Below signal.confirm_frames the
+  /// blob raises no alarm by itself.
+  int seen_frames = 0;
   /// Speed at which the distance shrinks, m/s, from the fit over the track (vision/tracking.hpp);
   /// when set, distance_m and ttc_s come from that fit too.
   std::optional<double> closing_speed_mps;

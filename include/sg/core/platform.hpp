@@ -28,4 +28,37 @@ Envelope platform_envelope(const std::string& name);
 /// Throws InputError naming the known platforms for an unknown name.
 void apply_platform(const std::string& name, DetectorParams& params);
 
+/// The image size, frame rate and focal length x baseline that the defaults were written for
+/// (the simulator's default camera): pixel sizes and frame gaps scale from it.
+inline constexpr int kReferenceWidth = 640;
+inline constexpr int kReferenceHeight = 480;
+inline constexpr double kReferenceFps = 30.0;
+/// The largest disparity range derived from a camera, px: beyond it matching costs grow and the
+/// left image loses that many columns.
+inline constexpr int kMaxDerivedDisparities = 256;
+
+/// What adapt_to_camera set, for the run's first line and its warnings.
+struct CameraFit {
+  double near_m = 0.0;  ///< the nearest depth the disparity range measures, f B / (range - 1)
+  double far_m = 0.0;   ///< the farthest depth any detection counts (the mode's z_max_m)
+  /// Set when the range was capped short of the contact distance: a line naming the nearest
+  /// measurable distance, for the user.
+  std::string warning;
+};
+
+/// Fits the defaults that depend on the camera to `camera`, for the envelope `params` holds
+/// (DESIGN 4.1, "defaults derived from the camera"). Apply it after the platform preset and before
+/// a config file and flags, which still override each value:
+///  * bm.num_disparities: the smallest multiple of 16 with f B / (d - 1) <= z_contact, so that the
+///    matcher still measures at the contact plane, capped at kMaxDerivedDisparities and below the
+///    image width (with `warning` set);
+///  * pixel areas (signal.min_area_px, signal.region_min_px) scale with the image area, and
+///    lengths (scene_flow.edge_margin_px) with its width, from kReferenceWidth x kReferenceHeight;
+///  * frame gaps (stereo.gaps, scene_flow.gaps) keep their span in seconds at the camera's rate
+///    (written for kReferenceFps): a 20-frame gap at 30 fps is 10 frames at 15 fps.
+CameraFit adapt_to_camera(DetectorParams& params, const Camera& camera);
+
+/// The nearest and farthest depth `params` measures with `camera` (CameraFit without a warning).
+CameraFit depth_range(const DetectorParams& params, const Camera& camera);
+
 }  // namespace sg::core

@@ -91,6 +91,7 @@ class LabelJob {
   bool short_chain_ = false;
   bool concluded_ = false;
   std::vector<core::Obstacle> obstacles_;  ///< conclude(): untracked obstacles
+  std::vector<ObstacleRun> obstacle_runs_; ///< conclude(): their pixels in danger_
   std::vector<int> region_pixels_;         ///< conclude(): dangerous pixels per region
 };
 

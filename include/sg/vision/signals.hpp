@@ -11,6 +11,12 @@
 
 namespace sg::vision {
 
+/// Pixels [x0, x1) of row y belong to obstacle `obstacle` (an index into extract_obstacles' result).
+struct ObstacleRun {
+  int y = 0, x0 = 0, x1 = 0;
+  int obstacle = 0;
+};
+
 /// Opening with an open_size square, then connected components (8-connected); blobs smaller than
 /// min_area_px are removed from `mask` (in place). Returns one Obstacle per kept blob, in
 /// raster order of their first pixel: bbox, pixels, median depth (m) of the blob's pixels with
@@ -18,11 +24,18 @@ namespace sg::vision {
 /// an even count average the two middle values. mask: CV_8U 0/255; disp: CV_32F (invalid < 0);
 /// ttc: CV_32F (NaN = none); all the same size. When `velocity` (CV_32FC3, m/s, NaN = unknown,
 /// the size of the mask) is given, each obstacle's velocity is the mean over its pixels whose
-/// three components are finite (left empty when none).
+/// three components are finite (left empty when none). When `runs` is given, it receives the
+/// kept blobs' pixels as row runs, each naming its obstacle's index in the result.
 std::vector<core::Obstacle> extract_obstacles(cv::Mat& mask, const cv::Mat& disp,
                                               const cv::Mat& ttc, const core::Camera& camera,
                                               const core::SignalParams& p,
-                                              const cv::Mat& velocity = cv::Mat());
+                                              const cv::Mat& velocity = cv::Mat(),
+                                              std::vector<ObstacleRun>* runs = nullptr);
+
+/// Clears from `mask` the blobs of the obstacles not `keep`: runs as extract_obstacles gave them,
+/// keep[i] for obstacle i. Returns whether any pixel was cleared.
+bool clear_obstacles(cv::Mat& mask, const std::vector<ObstacleRun>& runs,
+                     const std::vector<bool>& keep);
 
 /// Names of `columns` regions: {"left", "centre", "right"} for 3, else "r0", "r1", ...
 std::vector<std::string> region_names(int columns);

@@ -21,8 +21,10 @@ bool fit_line(const std::vector<double>& t, const std::vector<double>& z, double
 class ObstacleTracker {
  public:
   /// p must be valid; z_contact_m = the envelope's contact depth, m; z_near_limit_m = the
-  /// nearest depth the matcher measures, f B / (number of disparities - 1), m.
-  ObstacleTracker(const core::SignalParams& p, double z_contact_m, double z_near_limit_m = 0.0);
+  /// nearest depth the matcher measures, f B / (number of disparities - 1), m; focal_baseline =
+  /// f B, px m, for the depth error of a disparity error (0: no motion test, see update).
+  ObstacleTracker(const core::SignalParams& p, double z_contact_m, double z_near_limit_m = 0.0,
+                  double focal_baseline = 0.0);
 
   /// Matches `obstacles` (this frame's, at time_s) to the tracks of the previous frame: a pair
   /// matches when their boxes' intersection covers at least track_min_overlap of the smaller box,
@@ -37,7 +39,18 @@ class ObstacleTracker {
   /// one measured nearer than that, a saturated disparity, when its track closes in), and an
   /// unmatched track closing faster than 1 cm/s is appended to `obstacles` as a predicted one at
   /// its last box until its predicted TTC reaches 0.
+  /// seen_frames counts the consecutive frames of the track, restarting at 1 when the blob's
+  /// distance does not hold together with its motion: given a velocity, its distance must lie
+  /// within kMotionTolerance of the last measured one moved by V_z over the time between them.
   void update(double time_s, std::vector<core::Obstacle>& obstacles);
+
+  /// Whether a blob measured at z_now m agrees with the last measurement z_last of its track,
+  /// dt s ago, and its velocity's V_z (m/s): |z_now - (z_last + V_z dt)| <= 0.1 z_now (the blob's
+  /// extent changes from frame to frame) + 0.25 |V_z dt| (the velocity's own error) + twice the
+  /// depth error of a 1 px disparity error in each reading, z^2 / (f B) (mismatches aside, the
+  /// matcher errs by less). A mismatch read at a fixed wrong disparity while the flow says it moves
+  /// fast fails it; so does one whose distance jumps between fragments.
+  bool holds_together(double z_last, double z_now, double v_z, double dt) const;
 
   /// A blob fades some frames before its disparity leaves the matcher's range (the block's
   /// window straddles the limit, uniqueness fails): the near zone starts this far out.
@@ -49,6 +62,8 @@ class ObstacleTracker {
     double first_s = 0.0;  ///< when the track started, s
     cv::Rect bbox;
     std::deque<double> t, z;  ///< samples of the measured (median) distance
+    int seen = 0;             ///< consecutive frames seen, with a distance that holds together
+    double last_t = 0.0, last_z = 0.0;  ///< the last measured distance (last_z 0: none)
     bool fitted = false;      ///< the last fit: z(t) = fit_z + fit_rate (t - fit_t)
     double fit_t = 0.0, fit_z = 0.0, fit_rate = 0.0;
     /// Predicted distance at time_s; false without a fit.
@@ -65,6 +80,7 @@ class ObstacleTracker {
   core::SignalParams p_;
   double z_contact_m_;
   double z_near_limit_m_;
+  double focal_baseline_;
   std::vector<Track> tracks_;
   int next_id_ = 1;
 };
