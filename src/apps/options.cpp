@@ -167,6 +167,10 @@ void fit_to_camera(const std::string& config, const core::Camera& camera,
   params.scene_flow.edge_margin_px = derived.scene_flow.edge_margin_px;
   params.stereo.gaps = derived.stereo.gaps;
   params.scene_flow.gaps = derived.scene_flow.gaps;
+  params.signal.on_k = derived.signal.on_k;
+  params.signal.on_n = derived.signal.on_n;
+  params.signal.off_m = derived.signal.off_m;
+  params.signal.severity_off_frames = derived.signal.severity_off_frames;
 }
 
 }  // namespace

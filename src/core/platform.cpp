@@ -75,11 +75,16 @@ void apply_platform(const std::string& name, DetectorParams& params) {
 namespace sg::core {
 namespace {
 
+/// `frames` frames at kReferenceFps as frames at `fps`: the same time, at least 1 frame.
+int frames_at(int frames, double fps) {
+  return std::max(1, static_cast<int>(std::lround(frames * fps / kReferenceFps)));
+}
+
 /// Gaps of `gaps` frames at kReferenceFps, as frames at `fps`: the same spans, at least 1 frame,
 /// each once, in increasing order.
 std::vector<int> gaps_at(const std::vector<int>& gaps, double fps) {
   std::vector<int> out;
-  for (int k : gaps) out.push_back(std::max(1, static_cast<int>(std::lround(k * fps / kReferenceFps))));
+  for (int k : gaps) out.push_back(frames_at(k, fps));
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
@@ -127,6 +132,12 @@ CameraFit adapt_to_camera(DetectorParams& params, const Camera& camera) {
 
   params.stereo.gaps = gaps_at(params.stereo.gaps, camera.fps);
   params.scene_flow.gaps = gaps_at(params.scene_flow.gaps, camera.fps);
+  // The hysteresis' frame counts keep their time too (at least one frame each).
+  SignalParams& s = params.signal;
+  s.on_n = frames_at(s.on_n, camera.fps);
+  s.on_k = std::min(s.on_n, frames_at(s.on_k, camera.fps));
+  s.off_m = frames_at(s.off_m, camera.fps);
+  s.severity_off_frames = frames_at(s.severity_off_frames, camera.fps);
 
   CameraFit fit = depth_range(params, camera);
   if (wanted > cap) {

@@ -128,6 +128,17 @@ TEST(AdaptToCamera, SizesScaleWithTheImageAndGapsKeepTheirSeconds) {
   EXPECT_EQ(r.scene_flow.edge_margin_px, defaults.bm.block_size / 2);
   EXPECT_EQ(r.scene_flow.gaps, (std::vector<int>{1, 2, 5}));  // 1, 0.9, 2.3, 4.6 frames
   EXPECT_EQ(r.stereo.gaps, (std::vector<int>{1, 3}));         // 0.2, 1.2, 3.5 frames
+  // The hysteresis keeps its time, at least a frame: at 60 fps on 4 of 6 frames, off after 6;
+  // at 6.9 fps each frame decides (a frame is 0.14 s, more than the 0.1 s written for 30 fps).
+  EXPECT_EQ(q.signal.on_k, 4);
+  EXPECT_EQ(q.signal.on_n, 6);
+  EXPECT_EQ(q.signal.off_m, 6);
+  EXPECT_EQ(q.signal.severity_off_frames, 10);
+  EXPECT_EQ(r.signal.on_k, 1);
+  EXPECT_EQ(r.signal.on_n, 1);
+  EXPECT_EQ(r.signal.off_m, 1);
+  EXPECT_EQ(p.signal.on_k, defaults.signal.on_k);
+  EXPECT_EQ(p.signal.off_m, defaults.signal.off_m);
   EXPECT_TRUE(validate(r, small).empty());
 }
 

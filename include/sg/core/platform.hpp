@@ -54,8 +54,10 @@ struct CameraFit {
 ///    image width (with `warning` set);
 ///  * pixel areas (signal.min_area_px, signal.region_min_px) scale with the image area, and
 ///    lengths (scene_flow.edge_margin_px) with its width, from kReferenceWidth x kReferenceHeight;
-///  * frame gaps (stereo.gaps, scene_flow.gaps) keep their span in seconds at the camera's rate
-///    (written for kReferenceFps): a 20-frame gap at 30 fps is 10 frames at 15 fps.
+///  * frame counts keep their time at the camera's rate (written for kReferenceFps), at least one
+///    frame each: the gaps (stereo.gaps, scene_flow.gaps; a 20-frame gap at 30 fps is 10 frames
+///    at 15 fps) and the hysteresis (signal.on_k, on_n, off_m, severity_off_frames).
+///    signal.confirm_frames stays: it counts observations, not time.
 CameraFit adapt_to_camera(DetectorParams& params, const Camera& camera);
 
 /// The nearest and farthest depth `params` measures with `camera` (CameraFit without a warning).
