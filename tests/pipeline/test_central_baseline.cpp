@@ -6,6 +6,7 @@
 
 #include "../vision/synthetic.hpp"
 #include "sg/core/error.hpp"
+#include "sg/io/memory_source.hpp"
 #include "sg/pipeline/central_baseline.hpp"
 
 namespace sg::pipeline {
@@ -39,22 +40,6 @@ std::vector<core::StereoFrame> plane_frames(const std::vector<float>& disparitie
   return frames;
 }
 
-class VectorSource : public core::FrameSource {
- public:
-  VectorSource(std::vector<core::StereoFrame> frames, core::Camera camera)
-      : frames_(std::move(frames)), camera_(camera) {}
-  std::optional<core::StereoFrame> next() override {
-    if (next_ >= frames_.size()) return std::nullopt;
-    return frames_[next_++];
-  }
-  const core::Camera& camera() const override { return camera_; }
-  int size() const override { return static_cast<int>(frames_.size()); }
-
- private:
-  std::vector<core::StereoFrame> frames_;
-  core::Camera camera_;
-  std::size_t next_ = 0;
-};
 
 CentralBaselineOptions options() {
   CentralBaselineOptions o;
@@ -130,7 +115,8 @@ TEST(CentralBaseline, TheWindowIsTrailingHalfASecond) {
 }
 
 TEST(CentralBaseline, RunsASourceAndCountsAlarms) {
-  VectorSource source(plane_frames({10, 11, 12, 13, 14, 15}), small_camera());
+  const std::vector<core::StereoFrame> pairs = plane_frames({10, 11, 12, 13, 14, 15});
+  io::MemorySource source(pairs, small_camera());
   std::vector<int> frames;
   const RunSummary s = run_central_baseline(
       source, options(), [&](const core::StereoFrame& f, const core::Detection& d) {
@@ -145,7 +131,8 @@ TEST(CentralBaseline, RunsASourceAndCountsAlarms) {
 }
 
 TEST(CentralBaseline, InvalidParametersAreAnInputError) {
-  VectorSource source(plane_frames({10}), small_camera());
+  const std::vector<core::StereoFrame> pairs = plane_frames({10});
+  io::MemorySource source(pairs, small_camera());
   CentralBaselineOptions o = options();
   o.params.bm.num_disparities = 40;  // not a multiple of 16
   EXPECT_THROW(run_central_baseline(source, o, {}), core::InputError);
