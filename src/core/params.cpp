@@ -239,8 +239,8 @@ std::vector<std::string> validate(const SceneFlowParams& p) {
             p.min_delta_d_px, "must be >= 0");
   c.require(p.max_speed_mps > p.v_min_mps, "max_speed_mps", p.max_speed_mps,
             "must exceed v_min_mps");
-  c.require(std::isfinite(p.startup_doubt_px) && p.startup_doubt_px >= 0, "startup_doubt_px",
-            p.startup_doubt_px, "must be >= 0");
+  c.require(std::isfinite(p.startup_doubt_se) && p.startup_doubt_se >= 0, "startup_doubt_se",
+            p.startup_doubt_se, "must be >= 0");
   c.require(std::isfinite(p.surface_bridge_m) && p.surface_bridge_m >= 0 &&
                 p.surface_bridge_m <= 5.0,
             "surface_bridge_m", p.surface_bridge_m, "must be in 0..5");

@@ -50,6 +50,18 @@ Scenario head_on_fast() {
   return s;
 }
 
+Scenario cold_start() {
+  // Z_near 8.0 m at 3 m/s from the first frame: contact at 2.5 s (frame 75), so every frame is a
+  // GT alarm frame (TTC <= 3 s from the start). The alarm can come no earlier than the chain's
+  // first frames measure the approach (issue 36).
+  Scenario s = make("cold-start",
+                    "a 1.0 x 1.5 x 0.5 m box is already 8 m away approaching at 3 m/s when the "
+                    "run starts; collides",
+                    76);
+  s.obstacles.push_back(standing(s, 1, {1.0, 1.5, 0.5}, 0.0, 8.25, {0, 0, -3.0}, 131));
+  return s;
+}
+
 Scenario crossing() {
   // V_z = 0: never enters the envelope although it passes right in front of it.
   Scenario s = make("crossing",
@@ -242,6 +254,7 @@ const std::vector<std::pair<std::string, std::function<Scenario()>>>& registry()
       {"pedestrian", pedestrian},   {"thin-pole", thin_pole},
       {"overhang", overhang},       {"turning", turning},
       {"car-stopped", car_stopped}, {"car-cut-in", car_cut_in},
+      {"cold-start", cold_start},
   };
   return kAll;
 }

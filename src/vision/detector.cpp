@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <numeric>
 
 #include "sg/core/error.hpp"
 #include "sg/vision/edge_margin.hpp"
@@ -77,7 +76,8 @@ void LabelJob::run(cv::Range rows) {
     gaps.push_back({steps_[j], &past_[j], &past_edges_[j], spans_s_[j],
                     derotations_.empty() ? nullptr : &derotations_[j]});
   label_stereo_flow_rows(disparity_, edges_, flows, gaps, *camera_, p.envelope, p.scene_flow,
-                         danger_, ttc_, velocity_, rows);
+                         danger_, ttc_, velocity_, rows,
+                         startup_.residuals_m.empty() ? nullptr : &startup_.residuals_m);
 }
 
 Detector::Detector(const core::DetectorParams& params, const core::Camera& camera)
@@ -164,9 +164,20 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
         job.derotations_.push_back(chain);
       }
     }
-    // Over the first frames of a chain the disparity error dominates the fit (startup_doubt_px).
-    job.short_chain_ = params_.scene_flow.fit_velocity && reached < max_gap_;
     allocate_stereo_flow_outputs(disp.size(), job.danger_, job.ttc_, job.velocity_);
+    // Over the first frames of a chain (short of the longest gap) the disparity error dominates
+    // the fit: its residuals at each sample time (now, and each past frame of the chain once;
+    // after a dropped frame two gaps reach the same one) show how much (startup_doubt_se).
+    const core::SceneFlowParams& sf = params_.scene_flow;
+    if (sf.fit_velocity && sf.pool_surface_motion && sf.startup_doubt_se > 0 &&
+        reached < max_gap_) {
+      job.startup_.times_s = {0.0};
+      for (size_t j = 0; j < job.spans_s_.size(); ++j)
+        if (j == 0 || job.steps_[j] != job.steps_[j - 1])
+          job.startup_.times_s.push_back(-job.spans_s_[j]);
+      job.startup_.residuals_m.create(disp.size(),
+                                      CV_32FC(static_cast<int>(job.startup_.times_s.size())));
+    }
   } else if (core::is_surveyed(params_.mode)) {
     prepare_surveyed(frame, maps, job);
   } else {
@@ -227,19 +238,9 @@ void LabelJob::conclude() {
     // The velocities come from the longest gap that knows them: the noise gate uses its span.
     const double span_s =
         spans_s_.empty() ? 0.0 : *std::max_element(spans_s_.begin(), spans_s_.end());
-    // A chain short of its window: the spread of the fit's sample times (now and each past frame
-    // of the chain once; after a dropped frame two gaps reach the same one).
-    double spread = 0.0;
-    if (short_chain_) {
-      std::vector<double> times{0.0};
-      for (size_t j = 0; j < spans_s_.size(); ++j)
-        if (j == 0 || steps_[j] != steps_[j - 1]) times.push_back(-spans_s_[j]);
-      const double mean =
-          std::accumulate(times.begin(), times.end(), 0.0) / static_cast<double>(times.size());
-      for (double t : times) spread += (t - mean) * (t - mean);
-    }
     pool_surface_motion(disparity_, *camera_, p.envelope, sf, span_s, edges_, danger_, ttc_,
-                        velocity_, spread);
+                        velocity_, startup_);
+    startup_ = ChainResiduals{};  // a float a pixel per sample: not kept past the frame
   }
   if (flow_mode_ && sf.grow_into_edges)
     grow_danger_into_edges(disparity_, edges_, sf.edge_margin_px, sf.edge_step_px,

@@ -298,7 +298,7 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
                             const std::vector<const cv::Mat*>& flows,
                             const std::vector<GapSource>& gap_sources, const core::Camera& cam,
                             const core::Envelope& env, const SceneFlowParams& p, cv::Mat& danger,
-                            cv::Mat& ttc, cv::Mat& velocity, cv::Range rows) {
+                            cv::Mat& ttc, cv::Mat& velocity, cv::Range rows, cv::Mat* residuals) {
   if (disp_cur.type() != CV_32FC1) throw core::InputError("scene flow: disparity must be CV_32F");
   check_same(disp_cur, edges_cur, CV_8UC1, "the depth-edge mask");
   check_same(disp_cur, danger, CV_8UC1, "the danger output");
@@ -318,6 +318,10 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
                          [](const GapSource& a, const GapSource& b) { return a.steps == b.steps; }),
              gaps.end());
   const int longest = gaps.empty() ? 0 : gaps.back().steps;
+  // The fit's residuals: one channel for now, then one per distinct chain length.
+  const int slots = 1 + static_cast<int>(gaps.size());
+  if (residuals && !p.fit_velocity) residuals = nullptr;
+  if (residuals) check_same(disp_cur, *residuals, CV_32FC(slots), "the residual output");
   for (int j = 0; j < longest; ++j)
     check_same(disp_cur, *flows[static_cast<size_t>(j)], CV_32FC2, "a flow");
   const cv::Range r = rows == cv::Range::all() ? cv::Range(0, disp_cur.rows) : rows;
@@ -378,6 +382,8 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
     uint8_t* danger_row = danger.ptr<uint8_t>(y);
     float* ttc_row = ttc.ptr<float>(y);
     cv::Vec3f* vel_row = velocity.ptr<cv::Vec3f>(y);
+    float* res_row = residuals ? residuals->ptr<float>(y) : nullptr;
+    if (res_row) std::fill(res_row, res_row + static_cast<size_t>(slots) * disp_cur.cols, kNaN);
     live.clear();
     const auto fy = static_cast<float>(y);
     for (int x = 0; x < disp_cur.cols; ++x) {
@@ -394,7 +400,8 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
     }
     if (p.fit_velocity) candidates = live;
     int step = 0;
-    for (const GapSource& g : gaps) {
+    for (size_t gi = 0; gi < gaps.size(); ++gi) {
+      const GapSource& g = gaps[gi];
       for (; step < g.steps && !live.empty(); ++step) {
         const cv::Mat& flow = *flows[static_cast<size_t>(step)];
         size_t kept = 0;
@@ -420,6 +427,7 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
           // Weight 1 / var(Z) relative to now's: Z's error grows as Z^2 = (f B / d)^2.
           const double rel = static_cast<double>(d_prev) / d_row[x];
           fits[x].add(-g.span_s, P, rel * rel * rel * rel);
+          if (res_row) res_row[x * slots + static_cast<int>(gi) + 1] = static_cast<float>(P[2]);
         }
         continue;
       }
@@ -453,11 +461,24 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
     if (!p.fit_velocity) continue;
     for (const int x : candidates) {
       cv::Vec3d V;
-      if (!fits[x].slope(V)) continue;
+      if (!fits[x].slope(V)) {
+        if (res_row) std::fill_n(res_row + x * slots, slots, kNaN);
+        continue;
+      }
       const GapResult res = test.verdict(fits[x].now, d_row[x], V, fits[x].span_s);
       danger_row[x] = res.dangerous ? 255 : 0;
       ttc_row[x] = res.dangerous ? static_cast<float>(res.ttc) : kNaN;
       vel_row[x] = cv::Vec3f(res.velocity);
+      if (!res_row) continue;
+      // Z's distance from the fitted line at each sample: now, then the samples recorded above.
+      const VelocityFit& f = fits[x];
+      const double tb = f.st / f.sw, zb = f.sp[2] / f.sw;
+      float* r_px = res_row + x * slots;
+      r_px[0] = static_cast<float>(f.now[2] - zb + V[2] * tb);
+      for (int j = 1; j < slots; ++j)
+        if (!std::isnan(r_px[j]))
+          r_px[j] = static_cast<float>(r_px[j] - zb +
+                                       V[2] * (gaps[static_cast<size_t>(j - 1)].span_s + tb));
     }
   }
 }

@@ -62,6 +62,42 @@ void check_surface_inputs(const cv::Mat& disp, const cv::Mat& member) {
     throw core::InputError("surfaces: a CV_32F disparity and a CV_8U member mask of one size");
 }
 
+/// pool_surface_motion's doubt of each surface s with a middle half [vz_low[s], vz_high[s]] of
+/// its V_z (NaN: not doubted, doubt[s] left as is): slope_doubt of the mean residual at each
+/// sample time over the pixels of that middle half.
+void surface_doubts(const cv::Mat& labels, const cv::Mat& velocity, const ChainResiduals& startup,
+                    const std::vector<float>& vz_low, const std::vector<float>& vz_high,
+                    double doubt_se, std::vector<double>& doubt) {
+  const size_t slots = startup.times_s.size();
+  std::vector<double> sum(vz_low.size() * slots, 0.0);
+  std::vector<int> count(sum.size(), 0);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    const cv::Vec3f* v = velocity.ptr<cv::Vec3f>(y);
+    const float* r = startup.residuals_m.ptr<float>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      const auto s = static_cast<size_t>(l[x]);
+      // NaN bounds (no surface, or not doubted) fail the comparison.
+      if (!(v[x][2] >= vz_low[s] && v[x][2] <= vz_high[s]) || !finite(v[x])) continue;
+      const float* rx = r + static_cast<size_t>(x) * slots;
+      for (size_t j = 0; j < slots; ++j)
+        if (!std::isnan(rx[j])) {
+          sum[s * slots + j] += rx[j];
+          ++count[s * slots + j];
+        }
+    }
+  }
+  std::vector<double> mean(slots);
+  for (size_t s = 1; s < vz_low.size(); ++s) {
+    if (std::isnan(vz_low[s])) continue;
+    for (size_t j = 0; j < slots; ++j) {
+      const size_t i = s * slots + j;
+      mean[j] = count[i] > 0 ? sum[i] / count[i] : std::numeric_limits<double>::quiet_NaN();
+    }
+    doubt[s] = slope_doubt(startup.times_s, mean, doubt_se);
+  }
+}
+
 }  // namespace
 
 int label_surfaces_reference(const cv::Mat& disp, const cv::Mat& member, float step,
@@ -216,16 +252,56 @@ float interquartile_mean(float* v, size_t n) {
   return static_cast<float>(sum / static_cast<double>(high - low));
 }
 
+double slope_doubt(const std::vector<double>& times_s, const std::vector<double>& residuals,
+                   double doubt_se) {
+  // Student's t, 97.5 % quantile, by degrees of freedom 1..20; beyond, 1.96 + 2.4 / dof is
+  // within 0.01 of it.
+  static constexpr double kT975[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365,
+                                     2.306,  2.262, 2.228, 2.201, 2.179, 2.160, 2.145,
+                                     2.131,  2.120, 2.110, 2.101, 2.093, 2.086};
+  double n = 0.0, st = 0.0, sr = 0.0;
+  for (size_t j = 0; j < times_s.size(); ++j)
+    if (std::isfinite(residuals[j])) {
+      n += 1.0;
+      st += times_s[j];
+      sr += residuals[j];
+    }
+  if (n < 3.0) return std::numeric_limits<double>::infinity();
+  const double tb = st / n, rb = sr / n;
+  double stt = 0.0, str = 0.0, srr = 0.0;
+  for (size_t j = 0; j < times_s.size(); ++j)
+    if (std::isfinite(residuals[j])) {
+      const double dt = times_s[j] - tb, dr = residuals[j] - rb;
+      stt += dt * dt;
+      str += dt * dr;
+      srr += dr * dr;
+    }
+  if (!(stt > 0.0)) return std::numeric_limits<double>::infinity();
+  // Unweighted: over the few frames of a short chain the pixels' weights (d_k / d_i)^4 stay near
+  // one, except for near, fast approaches, which clear any doubt.
+  const double dof = n - 2.0;
+  const double ssr = std::max(0.0, srr - str * str / stt);
+  const double se = std::sqrt(ssr / dof / stt);
+  const double t = dof <= 20.0 ? kT975[static_cast<int>(dof) - 1] : 1.96 + 2.4 / dof;
+  return doubt_se * (t / 1.96) * se;
+}
+
 void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const core::Envelope& env,
                          const core::SceneFlowParams& p, double span_s, const cv::Mat& edges,
                          cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity,
-                         double time_spread_s2) {
+                         const ChainResiduals& startup) {
   if (disp.type() != CV_32FC1 || edges.type() != CV_8UC1 || danger.type() != CV_8UC1 ||
       ttc.type() != CV_32FC1 || velocity.type() != CV_32FC3 || edges.size() != disp.size() ||
       danger.size() != disp.size() || ttc.size() != disp.size() || velocity.size() != disp.size())
     throw core::InputError(
         "surface motion: maps must be CV_32F disparity, CV_8U danger, CV_32F TTC and CV_32FC3 "
         "velocity of one size");
+  if (!startup.residuals_m.empty() &&
+      (startup.residuals_m.type() != CV_32FC(static_cast<int>(startup.times_s.size())) ||
+       startup.residuals_m.size() != disp.size()))
+    throw core::InputError(
+        "surface motion: the residuals must be CV_32F with one channel per sample time, of the "
+        "maps' size");
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   // The labelling's candidates: valid, near enough, off the depth-edge margin, in the band.
   const float d_min = static_cast<float>(cam.focal_px * cam.baseline_m / p.z_max_m);
@@ -291,8 +367,24 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
     const cv::Vec3d V(pooled[s]);
     tested[s] = finite(pooled[s]) && V.dot(V) <= max_speed2 && V[2] <= -p.v_min_mps;
   }
+  // A chain short of its window: the doubt of each tested surface, from its own fit's scatter.
+  // interquartile_mean left each surface's V_z partitioned: its middle half is the middle ranks.
+  std::vector<double> doubt(surfaces, 0.0);
+  if (!startup.residuals_m.empty()) {
+    std::vector<float> vz_low(surfaces, kNaN), vz_high(surfaces, kNaN);
+    for (size_t s = 1; s < surfaces; ++s) {
+      if (!tested[s]) continue;
+      const size_t n = start[s + 1] - start[s];
+      const auto middle =
+          std::minmax_element(vz.begin() + static_cast<std::ptrdiff_t>(start[s] + n / 4),
+                              vz.begin() + static_cast<std::ptrdiff_t>(start[s + 1] - n / 4));
+      vz_low[s] = *middle.first;
+      vz_high[s] = *middle.second;
+    }
+    surface_doubts(labels, velocity, startup, vz_low, vz_high, p.startup_doubt_se, doubt);
+  }
   // Every candidate of a tested surface, a run of one surface's pixels at a time (SIMD).
-  const SurfaceTest test = make_surface_test(cam, env, p, span_s, time_spread_s2);
+  const SurfaceTest test = make_surface_test(cam, env, p, span_s);
   for (int y = 0; y < disp.rows; ++y) {
     const int* l = labels.ptr<int>(y);
     const float* d = disp.ptr<float>(y);
@@ -311,8 +403,10 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
         x = end;
         continue;
       }
-      if (tested[s])
-        test_surface_run(test, cv::Vec3d(pooled[s]), y, x, end, d, t);
+      // The slowest approach along the same path that the doubt allows decides.
+      const double keep = 1.0 - doubt[s] / -static_cast<double>(pooled[s][2]);
+      if (tested[s] && keep > 0.0)
+        test_surface_run(test, cv::Vec3d(pooled[s]), keep, y, x, end, d, t);
       else
         std::fill(t + x, t + end, kNaN);
       for (; x < end; ++x) {

@@ -21,16 +21,13 @@ namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 /// Whole vectors of test_surface_run from x0; returns where the scalar tail starts. The
-/// operations are those of test_surface_run_reference, lane by lane, in the same order. Without
-/// doubt (kDoubt false) keep is 1 exactly, as in the reference, and its divisions are left out.
-template <bool kDoubt>
-int TestRunVectorsT(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
-                    const float* d, float* ttc) {
+/// operations are those of test_surface_run_reference, lane by lane, in the same order.
+int TestRunVectors(const SurfaceTest& k, const cv::Vec3d& V, double keep, int y, int x0, int x1,
+                   const float* d, float* ttc) {
   const hn::ScalableTag<double> dd;
   const hn::Rebind<float, decltype(dd)> df;
   const int n = static_cast<int>(hn::Lanes(dd));
   const auto zero = hn::Zero(dd);
-  const auto one = hn::Set(dd, 1.0);
   const auto nan = hn::Set(dd, std::numeric_limits<double>::quiet_NaN());
   const auto cx = hn::Set(dd, k.cx);
   const auto focal = hn::Set(dd, k.focal_px);
@@ -38,13 +35,11 @@ int TestRunVectorsT(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int
   const auto y_off = hn::Set(dd, y - k.cy);
   const auto vz_span = hn::Set(dd, V[2] * k.span_s);
   const auto min_delta = hn::Set(dd, k.min_delta_d_px);
-  // The doubt is a template parameter, not a branch in the loop: GCC 12 if-converted such a
-  // branch into AVX-512 masked operations whose mask it set from the bool (0 or 1), so that only
-  // lane 0 took the doubt.
-  const auto doubt_px = hn::Set(dd, k.startup_doubt_px);
-  const auto sqrt_spread = hn::Set(dd, k.sqrt_time_spread);
-  const auto approach = hn::Set(dd, -V[2]);
-  const auto vx = hn::Set(dd, V[0]), vy = hn::Set(dd, V[1]), vz = hn::Set(dd, V[2]);
+  // V keep, per component as the reference's cv::Vec3d product rounds it.
+  const auto keep_v = hn::Set(dd, keep);
+  const auto kvx = hn::Set(dd, V[0] * keep), kvy = hn::Set(dd, V[1] * keep);
+  const auto kvz = hn::Set(dd, V[2] * keep);
+  const auto neg_kvz = hn::Set(dd, -(V[2] * keep));
   const auto neg_v_min = hn::Set(dd, -k.v_min_mps);
   const auto z_contact = hn::Set(dd, k.envelope.z_contact_m);
   const auto horizon = hn::Set(dd, k.envelope.horizon_s);
@@ -58,21 +53,14 @@ int TestRunVectorsT(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int
     const auto px = hn::Div(hn::Mul(hn::Sub(hn::Iota(dd, static_cast<double>(x)), cx), z), focal);
     const auto py = hn::Div(hn::Mul(y_off, z), focal);
     const auto z_before = hn::Sub(z, vz_span);
-    auto keep = one;
-    if constexpr (kDoubt) {
-      const auto sigma_v = hn::Div(hn::Div(hn::Mul(z, doubt_px), disp), sqrt_spread);
-      keep = hn::Sub(one, hn::Div(sigma_v, approach));
-    }
-    const auto kvz = hn::Mul(vz, keep);
-    const auto t_c = hn::Div(hn::Sub(z, z_contact), hn::Neg(kvz));
-    const auto ex = hn::Add(px, hn::Mul(hn::Mul(vx, keep), t_c));
-    const auto ey = hn::Add(py, hn::Mul(hn::Mul(vy, keep), t_c));
+    const auto t_c = hn::Div(hn::Sub(z, z_contact), neg_kvz);
+    const auto ex = hn::Add(px, hn::Mul(kvx, t_c));
+    const auto ey = hn::Add(py, hn::Mul(kvy, t_c));
     // Each failed condition turns the lane's TTC into NaN; the negated ones (> instead of <=)
     // fail on NaN as the reference's do.
-    auto t = hn::Mul(t_c, keep);
+    auto t = hn::Mul(t_c, keep_v);
     t = hn::IfThenElse(hn::Gt(z_before, zero), t, nan);
     t = hn::IfThenElse(hn::Ge(hn::Sub(disp, hn::Div(fb, z_before)), min_delta), t, nan);
-    t = hn::IfThenElse(hn::Gt(keep, zero), t, nan);
     t = hn::IfThenElse(hn::Le(kvz, neg_v_min), t, nan);
     t = hn::IfThenElse(hn::Gt(t_c, zero), t, nan);
     t = hn::IfThenElse(hn::Gt(t_c, horizon), nan, t);
@@ -82,13 +70,6 @@ int TestRunVectorsT(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int
     hn::StoreU(hn::DemoteTo(df, t), df, ttc + x);
   }
   return x;
-}
-
-int TestRunVectors(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
-                   const float* d, float* ttc) {
-  const bool doubt = k.sqrt_time_spread > 0.0 && V[2] < 0.0;
-  return doubt ? TestRunVectorsT<true>(k, V, y, x0, x1, d, ttc)
-               : TestRunVectorsT<false>(k, V, y, x0, x1, d, ttc);
 }
 
 std::int64_t CurrentTarget() { return HWY_TARGET; }
@@ -105,8 +86,7 @@ HWY_EXPORT(CurrentTarget);
 }  // namespace surface_detail
 
 SurfaceTest make_surface_test(const core::Camera& cam, const core::Envelope& env,
-                              const core::SceneFlowParams& p, double span_s,
-                              double time_spread_s2) {
+                              const core::SceneFlowParams& p, double span_s) {
   SurfaceTest k;
   k.cx = cam.cx;
   k.cy = cam.cy;
@@ -116,16 +96,12 @@ SurfaceTest make_surface_test(const core::Camera& cam, const core::Envelope& env
   k.min_delta_d_px = p.min_delta_d_px;
   k.v_min_mps = p.v_min_mps;
   k.envelope = env;
-  if (time_spread_s2 > 0.0) {
-    k.startup_doubt_px = p.startup_doubt_px;
-    k.sqrt_time_spread = std::sqrt(time_spread_s2);
-  }
   return k;
 }
 
-void test_surface_run_reference(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
-                                const float* d, float* ttc) {
-  const bool doubt = k.sqrt_time_spread > 0.0 && V[2] < 0.0;
+void test_surface_run_reference(const SurfaceTest& k, const cv::Vec3d& V, double keep, int y,
+                                int x0, int x1, const float* d, float* ttc) {
+  const cv::Vec3d kept = V * keep;
   for (int x = x0; x < x1; ++x) {
     ttc[x] = std::numeric_limits<float>::quiet_NaN();
     const double disp = d[x];
@@ -133,22 +109,17 @@ void test_surface_run_reference(const SurfaceTest& k, const cv::Vec3d& V, int y,
     const cv::Point3d P((x - k.cx) * z / k.focal_px, (y - k.cy) * z / k.focal_px, z);
     const double z_before = z - V[2] * k.span_s;
     if (!(z_before > 0.0 && disp - k.fb / z_before >= k.min_delta_d_px)) continue;
-    // A short chain: the slowest approach along the same path that its error allows decides.
-    double keep = 1.0;
-    if (doubt) {
-      const double sigma_v = z * k.startup_doubt_px / disp / k.sqrt_time_spread;
-      keep = 1.0 - sigma_v / -V[2];
-    }
     double t_c = 0.0;
-    if (keep > 0.0 && heads_into_envelope(P, V * keep, k.envelope, k.v_min_mps, t_c))
+    if (heads_into_envelope(P, kept, k.envelope, k.v_min_mps, t_c))
       ttc[x] = static_cast<float>(t_c * keep);  // the TTC of V itself
   }
 }
 
-void test_surface_run(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
+void test_surface_run(const SurfaceTest& k, const cv::Vec3d& V, double keep, int y, int x0, int x1,
                       const float* d, float* ttc) {
-  const int tail = HWY_DYNAMIC_DISPATCH(surface_detail::TestRunVectors)(k, V, y, x0, x1, d, ttc);
-  test_surface_run_reference(k, V, y, tail, x1, d, ttc);
+  const int tail =
+      HWY_DYNAMIC_DISPATCH(surface_detail::TestRunVectors)(k, V, keep, y, x0, x1, d, ttc);
+  test_surface_run_reference(k, V, keep, y, tail, x1, d, ttc);
 }
 
 std::string surface_test_target() {

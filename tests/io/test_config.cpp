@@ -52,7 +52,7 @@ TEST(Config, FlowAndSceneFlowSections) {
                                "  z_max_m: 15\n"
                                "  edge_margin_px: 3\n"
                                "  longest_gap_decides: false\n"
-                               "  startup_doubt_px: 0.3\n"
+                               "  startup_doubt_se: 1.5\n"
                                "  surface_bridge_m: 0.5\n"
                                "  exclude_ground: true\n"
                                "  ground: {tolerance_m: 0.1, min_inliers: 50}\n");
@@ -66,7 +66,7 @@ TEST(Config, FlowAndSceneFlowSections) {
   EXPECT_DOUBLE_EQ(p.scene_flow.z_max_m, 15.0);
   EXPECT_EQ(p.scene_flow.edge_margin_px, 3);
   EXPECT_FALSE(p.scene_flow.longest_gap_decides);
-  EXPECT_DOUBLE_EQ(p.scene_flow.startup_doubt_px, 0.3);
+  EXPECT_DOUBLE_EQ(p.scene_flow.startup_doubt_se, 1.5);
   EXPECT_DOUBLE_EQ(p.scene_flow.surface_bridge_m, 0.5);
   EXPECT_TRUE(p.scene_flow.exclude_ground);
   EXPECT_DOUBLE_EQ(p.scene_flow.ground.tolerance_m, 0.1);

@@ -43,7 +43,7 @@ TEST(Scenario, BuiltinsIncludeTheRequiredOnesAndValidate) {
   const std::set<std::string> have(names.begin(), names.end());
   for (const char* required :
        {"head-on", "crossing", "receding", "static", "ego-wall", "ego-pass", "two-obstacles",
-        "thin-pole", "overhang", "turning", "car-stopped", "car-cut-in"})
+        "thin-pole", "overhang", "turning", "car-stopped", "car-cut-in", "cold-start"})
     EXPECT_TRUE(have.count(required)) << required;
   for (const auto& name : names) {
     const Scenario s = builtin_scenario(name);

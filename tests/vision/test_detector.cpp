@@ -192,11 +192,13 @@ TEST(DetectorStereoFlow, HeadOnPatchFiresWithItsVelocity) {
   }
   EXPECT_FALSE(out[0].signal);
   EXPECT_EQ(cv::countNonZero(out[0].danger), 0);  // no history yet
-  // The disparity grows by 0.36 px a frame, below min_delta_d_px. Frames 2 and 3 fit a chain short
-  // of the longest gap: doubted by startup_doubt_px, their slowest plausible approach (1 m/s at
-  // frame 3) is too slow; from frame 4 the window is full (1.4 px over its span). The blob is
-  // confirmed on its second frame (5), and with on_k = 2 the signal is on from frame 6 to the end.
-  for (int i = 0; i < 16; ++i) EXPECT_EQ(out[i].signal, i >= 6) << "frame " << i;
+  // The disparity grows by 0.36 px a frame, below min_delta_d_px: frame 1 is noise. Frames 2 and
+  // 3 fit a chain short of the longest gap, doubted by the scatter of the patch's positions about
+  // their line: the pixels' 0.1 px errors average out over the patch, so its approach stands
+  // clear of the doubt at once (a fixed doubt of 0.6 px held it back until the window was full,
+  // frame 4). The blob is confirmed on its second frame (3), and with on_k = 2 the signal is on
+  // from frame 4 to the end.
+  for (int i = 0; i < 16; ++i) EXPECT_EQ(out[i].signal, i >= 4) << "frame " << i;
   const core::Detection& last = out[15];
   ASSERT_TRUE(last.signal);
   EXPECT_TRUE(last.regions[1].fired);
@@ -287,8 +289,8 @@ TEST(DetectorStereoFlow, DroppedFrameShortensTheChain) {
       ttc.push_back(d.obstacles.empty() || !d.obstacles[0].ttc_s ? -1.0 : *d.obstacles[0].ttc_s);
     }
     EXPECT_FALSE(dangerous[0]) << "fit " << fit;
-    // Gap 2 alone needs two frames; the fit's first pair (frame 1, 0.1 s) is doubted by
-    // startup_doubt_px: 3 m/s over 0.1 s at 4.7 m is within its noise.
+    // Gap 2 alone needs two frames; the fit's first pair (frame 1, 0.1 s) shows no scatter to
+    // measure its error by, so the chain short of its window is not trusted yet.
     EXPECT_FALSE(dangerous[1]) << "fit " << fit;
     for (size_t j = 2; j < dangerous.size(); ++j)
       EXPECT_TRUE(dangerous[j]) << "arrival " << j << " fit " << fit;
@@ -300,15 +302,17 @@ TEST(DetectorStereoFlow, DroppedFrameShortensTheChain) {
 // Over the first frames of a chain the velocity fit is dominated by the disparity error
 // (simulated thin-pole: a 0.6 px step of the matcher within 4 frames at 7.6 m read -5.8 m/s for
 // a true -1.4, an alarm 4 s early), so until the chain reaches the longest gap the envelope test
-// doubts it by startup_doubt_px. Here (f B = 50 px m, 10 fps, gaps 1 and 10): a static patch 8 m
-// away whose disparity steps up by 1 px at frame 2 fits -6 m/s over 0.2 s (TTC 1.1 s) and alarms
-// when the first frames are trusted, never when doubted; a patch 5 m away at 3 m/s stands clear
-// of the doubt by frame 3 (0.3 m a frame: its slowest plausible approach, 2.1 m/s, meets the
-// 3 s horizon).
+// doubts each surface's velocity by the scatter of its own positions about its fitted line
+// (startup_doubt_se standard errors). Here (f B = 50 px m, 10 fps, gaps 1 and 10): a static
+// patch 8 m away whose disparity steps up by 1 px at frame 2 fits -6 m/s over 0.2 s (TTC 1.1 s)
+// and alarms when the first frames are trusted, never when doubted (the step leaves its
+// positions as far off their line as the motion it fits); a patch 5 m away at 3 m/s lies on its
+// line within the pixels' noise and is trusted from its third frame, the first with a scatter
+// to measure.
 TEST(DetectorStereoFlow, TheFirstFramesOfAChainAlarmOnlyOnAnApproachClearOfTheirNoise) {
-  auto dangerous_frames = [](double doubt_px, auto depth) {
+  auto dangerous_frames = [](double doubt_se, auto depth) {
     core::DetectorParams params = flow_params_at_once({1, 10});
-    params.scene_flow.startup_doubt_px = doubt_px;
+    params.scene_flow.startup_doubt_se = doubt_se;
     Detector det(params, camera());
     cv::RNG rng(15);
     std::vector<int> frames;
@@ -325,11 +329,39 @@ TEST(DetectorStereoFlow, TheFirstFramesOfAChainAlarmOnlyOnAnApproachClearOfTheir
   const std::vector<int> trusted = dangerous_frames(0.0, stepped);
   ASSERT_FALSE(trusted.empty());
   EXPECT_EQ(trusted.front(), 2);
-  EXPECT_TRUE(dangerous_frames(0.6, stepped).empty());
-  const std::vector<int> caught = dangerous_frames(0.6, approaching);
+  EXPECT_TRUE(dangerous_frames(2.0, stepped).empty());
+  const std::vector<int> caught = dangerous_frames(2.0, approaching);
   ASSERT_FALSE(caught.empty());
-  EXPECT_LE(caught.front(), 3);
+  EXPECT_EQ(caught.front(), 2);
   EXPECT_EQ(caught.back(), 7);
+}
+
+// The same after frames dropped at the start of a stream (1 and 2 never arrive): the chain's
+// samples carry their real times, and a well-measured approach is trusted as soon as it has three
+// of them. A patch 8 m away at 2.5 m/s (TTC 3.0 s at frame 0) is dangerous from frame 4 (samples
+// at 0, 0.3 and 0.4 s); a fixed doubt of 0.6 px held it back until frame 8, as for a far
+// approach the error it assumed is most of the motion of the first frames. The stepped patch of
+// the test above stays safe.
+TEST(DetectorStereoFlow,
+     AfterFramesDroppedAtTheStartAWellMeasuredApproachIsTrustedAtItsThirdSample) {
+  auto dangerous_frames = [](auto depth) {
+    Detector det(flow_params_at_once({1, 10}), camera());
+    cv::RNG rng(16);
+    std::vector<int> frames;
+    for (int i : {0, 3, 4, 5, 6, 7, 8, 9}) {
+      const core::Detection d = det.process(
+          frame(i), {scene(depth(i), rng, 0.05), i == 0 ? cv::Mat() : patch_flow(kPatch, 0)});
+      if (cv::countNonZero(d.danger) > 0) frames.push_back(i);
+    }
+    return frames;
+  };
+  const std::vector<int> caught = dangerous_frames([](int i) { return 8.0 - 0.25 * i; });
+  ASSERT_FALSE(caught.empty());
+  EXPECT_EQ(caught.front(), 4);
+  EXPECT_EQ(caught.back(), 9);
+  const double fb = camera().focal_px * camera().baseline_m;
+  EXPECT_TRUE(
+      dangerous_frames([fb](int i) { return i < 4 ? 8.0 : fb / (fb / 8.0 + 1.0); }).empty());
 }
 
 TEST(DetectorStereoFlow, BadFlowIsAnInputError) {

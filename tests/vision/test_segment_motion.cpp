@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "sg/core/error.hpp"
 #include "sg/vision/scene_flow.hpp"
@@ -124,6 +126,86 @@ TEST(PoolSurfaceMotion, SurfacesKeepTheirOwnVelocityAndOutliersDoNotCount) {
   EXPECT_NEAR(m.velocity.at<cv::Vec3f>(60, 120)[2], 0.0, 0.1);
   EXPECT_NEAR(m.velocity.at<cv::Vec3f>(60, 50)[2], -2.0, 0.1);
   EXPECT_EQ(cv::countNonZero(m.danger(kLeft)), kLeft.area());
+}
+
+// A chain short of its window (the first frames of a stream): each surface's velocity is
+// doubted by the scatter of its own positions about its fitted line. Two patches 6 m away
+// approach at 2.2 m/s (TTC 2.5 s) over 6 samples 1/30 s apart. The left one's mean residuals
+// scatter by about 1 cm (a large, well-measured face; pixel noise of 5 cm averages out over its
+// 1600 pixels): doubted by about 0.2 m/s, its slowest plausible approach still meets the horizon.
+// The right one's follow a staircase of up to 20 cm, as the thin pole's did: its doubt exceeds
+// its approach. A fifth of the left patch are mismatches (-30 m/s, residuals of 1 m): outside
+// the middle half of its V_z, they are no part of its scatter.
+TEST(PoolSurfaceMotion, AShortChainTrustsEachSurfaceAsFarAsItsOwnScatterAllows) {
+  const core::SceneFlowParams p;
+  const cv::Vec3d v(0, 0, -(6.0 - 0.5) / 2.5);
+  const std::vector<double> times = {0.0, -1 / 30.0, -2 / 30.0, -3 / 30.0, -4 / 30.0, -5 / 30.0};
+  const std::vector<double> clean = {0.01, -0.01, 0.0, 0.01, -0.01, 0.0};
+  const std::vector<double> stairs = {0.1, 0.05, -0.2, -0.15, 0.1, 0.1};
+  auto run = [&](bool doubted) {
+    Maps m;
+    cv::RNG rng(21);
+    m.patch(kLeft, 6.0, v, 0.05, rng);
+    m.patch(kRight, 6.0, v, 0.05, rng);
+    const int slots = static_cast<int>(times.size());
+    ChainResiduals startup{cv::Mat(m.disp.size(), CV_32FC(slots)), times};
+    std::fill_n(startup.residuals_m.ptr<float>(), startup.residuals_m.total() * slots, kNaN);
+    auto fill = [&](const cv::Rect& r, const std::vector<double>& common) {
+      for (int y = r.y; y < r.br().y; ++y)
+        for (int x = r.x; x < r.br().x; ++x) {
+          float* res = startup.residuals_m.ptr<float>(y) + x * slots;
+          for (int j = 0; j < slots; ++j)
+            res[j] = static_cast<float>(common[static_cast<size_t>(j)] + rng.gaussian(0.05));
+        }
+    };
+    fill(kLeft, clean);
+    fill(kRight, stairs);
+    for (int y = kLeft.y; y < kLeft.br().y; ++y)
+      for (int x = kLeft.x; x < kLeft.x + 8; ++x) {
+        m.velocity.at<cv::Vec3f>(y, x) = {0, 0, -30};
+        float* res = startup.residuals_m.ptr<float>(y) + x * slots;
+        for (int j = 0; j < slots; ++j) res[j] = j % 2 ? 1.0f : -1.0f;
+      }
+    pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity,
+                        doubted ? startup : ChainResiduals{});
+    return std::make_pair(cv::countNonZero(m.danger(kLeft)), cv::countNonZero(m.danger(kRight)));
+  };
+  const auto trusted = run(false);
+  EXPECT_EQ(trusted.first, kLeft.area());
+  EXPECT_EQ(trusted.second, kRight.area());
+  const auto doubted = run(true);
+  EXPECT_EQ(doubted.first, kLeft.area());
+  EXPECT_EQ(doubted.second, 0);
+}
+
+// The doubt is doubt_se standard errors of the slope of a line through the residuals, widened as
+// Student's t for few samples; it needs three samples to measure a scatter at all.
+TEST(SlopeDoubt, StandardErrorsOfTheResidualsScatterWidenedForFewSamples) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // Three samples 0.1 s apart, the middle one 1 cm off the line through the others: the line
+  // fitted through all three leaves a sum of squares 6.67e-5 m^2 over sum (t - mean)^2 = 0.02 s^2
+  // and one degree of freedom: standard error 0.0577 m/s; t_0.975(1) = 12.706 = 6.48 x 1.96.
+  EXPECT_NEAR(slope_doubt({0.0, -0.1, -0.2}, {0.0, 0.01, 0.0}, 2.0), 2.0 * 12.706 / 1.96 * 0.057735,
+              1e-4);
+  EXPECT_NEAR(slope_doubt({0.0, -0.1, -0.2}, {0.0, 0.01, 0.0}, 1.0), 12.706 / 1.96 * 0.057735,
+              1e-4);
+  // Residuals on any straight line: no scatter.
+  EXPECT_NEAR(slope_doubt({0.0, -0.1, -0.3, -0.4}, {0.1, 0.08, 0.04, 0.02}, 2.0), 0.0, 1e-6);
+  // Two samples, or three of which one is missing: nothing to measure yet.
+  EXPECT_EQ(slope_doubt({0.0, -0.1}, {0.0, 0.01}, 2.0), inf);
+  EXPECT_EQ(slope_doubt({0.0, -0.1, -0.2}, {0.0, nan, 0.01}, 2.0), inf);
+  // The same scatter over more samples: a smaller doubt, the more so as t shrinks towards 1.96.
+  std::vector<double> t, r;
+  double last = inf;
+  for (int n = 1; n <= 21; ++n) {
+    t.push_back(-0.1 * (n - 1));
+    r.push_back(n % 2 ? 0.01 : -0.01);
+    if (n < 3) continue;
+    const double d = slope_doubt(t, r, 2.0);
+    EXPECT_LT(d, last) << n;
+    last = d;
+  }
 }
 
 // Velocities from quantized disparities cluster on a few values; the pooled velocity must average

@@ -51,20 +51,22 @@ std::vector<Case> random_cases(int count, std::uint64_t seed) {
   return cases;
 }
 
-SurfaceTest frame_test(double time_spread_s2) {
+SurfaceTest frame_test() {
   core::Camera cam;  // f = 500 px, B = 0.12 m
   core::SceneFlowParams p;
-  return make_surface_test(cam, core::Envelope{}, p, 20.0 / 30.0, time_spread_s2);
+  return make_surface_test(cam, core::Envelope{}, p, 20.0 / 30.0);
 }
 
 /// Outputs of test_surface_run and of the reference for every case, with sentinels around the
 /// run; counts of dangerous pixels.
-void run_both(const SurfaceTest& k, const std::vector<Case>& cases, int& dangerous, int& safe) {
+void run_both(const SurfaceTest& k, double keep, const std::vector<Case>& cases, int& dangerous,
+              int& safe) {
   dangerous = safe = 0;
   for (const Case& c : cases) {
     std::vector<float> fast(640, kSentinel), slow(640, kSentinel);
-    test_surface_run(k, c.velocity, c.y, c.x0, c.x1, c.disparity.data(), fast.data());
-    test_surface_run_reference(k, c.velocity, c.y, c.x0, c.x1, c.disparity.data(), slow.data());
+    test_surface_run(k, c.velocity, keep, c.y, c.x0, c.x1, c.disparity.data(), fast.data());
+    test_surface_run_reference(k, c.velocity, keep, c.y, c.x0, c.x1, c.disparity.data(),
+                               slow.data());
     const std::vector<std::uint32_t> a = bits(fast), b = bits(slow);
     const auto first = std::mismatch(a.begin(), a.end(), b.begin()).first - a.begin();
     ASSERT_EQ(a, b) << "run y " << c.y << " x " << c.x0 << ".." << c.x1 << " V " << c.velocity
@@ -87,12 +89,13 @@ TEST(SurfaceTest, EveryTargetEqualsTheScalarReferenceBitForBit) {
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
     ASSERT_EQ(surface_test_target(), hwy::TargetName(target));
-    for (double spread : {0.0, 0.02}) {
+    // keep 1: no doubt; the others: a surface's doubt leaves part of its approach.
+    for (double keep : {1.0, 0.71, 0.3}) {
       int dangerous = 0, safe = 0;
-      run_both(frame_test(spread), cases, dangerous, safe);
+      run_both(frame_test(), keep, cases, dangerous, safe);
       // Both verdicts occur often, so that a kernel wrong either way fails.
-      EXPECT_GT(dangerous, 5000) << hwy::TargetName(target) << " spread " << spread;
-      EXPECT_GT(safe, 5000) << hwy::TargetName(target) << " spread " << spread;
+      EXPECT_GT(dangerous, 5000) << hwy::TargetName(target) << " keep " << keep;
+      EXPECT_GT(safe, 5000) << hwy::TargetName(target) << " keep " << keep;
     }
   }
   hwy::SetSupportedTargetsForTest(0);
@@ -100,30 +103,29 @@ TEST(SurfaceTest, EveryTargetEqualsTheScalarReferenceBitForBit) {
 
 TEST(SurfaceTest, ReportsTheContactTimeOfAPointStraightAhead) {
   // d = 12 px: Z = 60 / 12 = 5 m on the optical axis, approaching at 2 m/s: t_c = (5 - 0.5) / 2.
-  const SurfaceTest k = frame_test(0.0);
+  const SurfaceTest k = frame_test();
   std::vector<float> d(640, 12.0f), ttc(640, kSentinel);
-  test_surface_run(k, {0.0, 0.0, -2.0}, 240, 300, 340, d.data(), ttc.data());
+  test_surface_run(k, {0.0, 0.0, -2.0}, 1.0, 240, 300, 340, d.data(), ttc.data());
   for (int x = 300; x < 340; ++x) EXPECT_FLOAT_EQ(ttc[static_cast<size_t>(x)], 2.25f) << x;
   // Receding, too slow to show over the span, or passing wide: never dangerous.
   for (const cv::Vec3d& v : {cv::Vec3d(0, 0, 2), cv::Vec3d(0, 0, -0.2), cv::Vec3d(4, 0, -2)}) {
-    test_surface_run(k, v, 240, 300, 340, d.data(), ttc.data());
+    test_surface_run(k, v, 1.0, 240, 300, 340, d.data(), ttc.data());
     for (int x = 300; x < 340; ++x) EXPECT_TRUE(std::isnan(ttc[static_cast<size_t>(x)])) << v;
   }
 }
 
-TEST(SurfaceTest, AShortChainsDoubtSlowsTheApproachTested) {
-  // Z = 5 m ahead, approaching at 1.8 m/s: t_c = (5 - 0.5) / 1.8 = 2.5 s without doubt. With
-  // doubt, sigma_V = (Z 0.6 / d) / sqrt(spread) = 0.25 / sqrt(spread) m/s is taken off the
-  // approach; the TTC reported stays that of V itself.
+TEST(SurfaceTest, ADoubtedSurfaceIsTestedWithTheShareOfItsApproachLeft) {
+  // Z = 5 m ahead, approaching at 1.8 m/s: t_c = (5 - 0.5) / 1.8 = 2.5 s. A doubt of sigma_V m/s
+  // leaves keep = 1 - sigma_V / 1.8 of the approach to test; the TTC reported stays that of V.
   std::vector<float> d(640, 12.0f), ttc(640, kSentinel);
   const cv::Vec3d v(0.0, 0.0, -1.8);
-  test_surface_run(frame_test(0.0), v, 240, 312, 328, d.data(), ttc.data());
+  test_surface_run(frame_test(), v, 1.0, 240, 312, 328, d.data(), ttc.data());
   EXPECT_FLOAT_EQ(ttc[312], 2.5f);
-  // spread 1 s^2: 1.55 m/s reaches contact after 2.9 s, inside the 3 s horizon.
-  test_surface_run(frame_test(1.0), v, 240, 312, 328, d.data(), ttc.data());
+  // sigma_V 0.25 m/s: 1.55 m/s reaches contact after 2.9 s, inside the 3 s horizon.
+  test_surface_run(frame_test(), v, 1.0 - 0.25 / 1.8, 240, 312, 328, d.data(), ttc.data());
   EXPECT_FLOAT_EQ(ttc[312], 2.5f);
-  // spread 0.25 s^2: 1.3 m/s needs 3.46 s, beyond the horizon.
-  test_surface_run(frame_test(0.25), v, 240, 312, 328, d.data(), ttc.data());
+  // sigma_V 0.5 m/s: 1.3 m/s needs 3.46 s, beyond the horizon.
+  test_surface_run(frame_test(), v, 1.0 - 0.5 / 1.8, 240, 312, 328, d.data(), ttc.data());
   EXPECT_TRUE(std::isnan(ttc[312]));
 }
 

@@ -208,11 +208,14 @@ struct SceneFlowParams {
   /// Until the velocity fit's chain reaches the longest gap (the first frames of a stream), the
   /// disparity error dominates the fit (simulated thin-pole, 4 frames at 7.6 m: -5.8 m/s for a
   /// true -1.4): the envelope test then uses the slowest approach along the measured path that
-  /// an error of this much in every disparity could hide, V (1 - sigma_V / -V_z), with sigma_V
-  /// the fit's standard error for depths that err by Z startup_doubt_px / d (pool_surface_motion).
-  /// 0.6 px: two standard errors of a 0.3 px matching error (a 1 px quantization's). A near,
-  /// fast approach stands clear of it within a few frames; 0 trusts the first frames fully.
-  double startup_doubt_px = 0.6;
+  /// this many standard errors of the surface's velocity could hide, V (1 - sigma_V / -V_z).
+  /// The standard error is the one the data show: the scatter of the surface's mean residuals
+  /// about its fitted line (pool_surface_motion, slope_doubt), widened as Student's t for few
+  /// samples; none is trusted before three samples. A large surface seen well is trusted at once
+  /// (cold-start: the box alarms at frame 7, as with no doubt, instead of 15 with an assumed
+  /// 0.6 px error), a pole whose disparity steps is not (thin-pole false_alarm_rate 0.014; with
+  /// no doubt 0.082). 0 trusts the first frames fully.
+  double startup_doubt_se = 2.0;
   /// Velocities faster than this are mismatches and are ignored, m/s.
   double max_speed_mps = 40.0;
   /// The past disparity D_{i-k}(q) is unknown when the neighbours its bilinear sample uses differ

@@ -19,6 +19,7 @@
 #include "sg/core/frame.hpp"
 #include "sg/core/params.hpp"
 #include "sg/vision/scene_flow.hpp"
+#include "sg/vision/segment_motion.hpp"
 #include "sg/vision/signals.hpp"
 #include "sg/vision/tracking.hpp"
 
@@ -86,9 +87,10 @@ class LabelJob {
   // the history holds nothing to compare with (nothing is dangerous then).
   cv::Mat left_, earlier_left_;
   double span_s_ = 0.0;
-  /// Stereo-Flow with the velocity fit: the chain does not reach the longest gap yet (the start
-  /// of a stream), so pooling doubts the fit by scene_flow.startup_doubt_px.
-  bool short_chain_ = false;
+  /// Stereo-Flow with the velocity fit while the chain does not reach the longest gap yet (the
+  /// start of a stream): the fit's residuals, by which pooling doubts each surface's velocity
+  /// (scene_flow.startup_doubt_se); empty otherwise.
+  ChainResiduals startup_;
   bool concluded_ = false;
   std::vector<core::Obstacle> obstacles_;  ///< conclude(): untracked obstacles
   std::vector<ObstacleRun> obstacle_runs_; ///< conclude(): their pixels in danger_

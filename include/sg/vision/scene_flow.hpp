@@ -110,12 +110,17 @@ void allocate_stereo_flow_outputs(cv::Size size, cv::Mat& danger, cv::Mat& ttc, 
 /// tiles stitched give the same maps as one call over all rows. With p.pool_surface_motion and
 /// p.chain_stride > 1, candidates nearer than p.chain_stride_z_m are followed only on every
 /// chain_stride-th row and column (by absolute position); the others stay unlabelled, with an
-/// unknown velocity, for pool_surface_motion to fill in.
+/// unknown velocity, for pool_surface_motion to fill in. residuals (optional, p.fit_velocity
+/// only): CV_32FC(1 + n) of disp_cur's size, n = the number of distinct steps among the gaps
+/// used; per pixel whose fit gives a velocity, Z minus the fitted line at each sample (channel
+/// 0: now; channel j: the j-th shortest chain's past frame), m, NaN where the chain gave no
+/// sample; NaN at every other pixel (rows `rows` only).
 void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
                             const std::vector<const cv::Mat*>& flows,
                             const std::vector<GapSource>& gaps, const core::Camera& cam,
                             const core::Envelope& env, const SceneFlowParams& p, cv::Mat& danger,
-                            cv::Mat& ttc, cv::Mat& velocity, cv::Range rows);
+                            cv::Mat& ttc, cv::Mat& velocity, cv::Range rows,
+                            cv::Mat* residuals = nullptr);
 
 /// A plane n . P + c = 0 in camera coordinates (|n| = 1, n pointing up, i.e. n_y < 0).
 struct GroundPlane {

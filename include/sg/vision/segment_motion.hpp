@@ -43,6 +43,26 @@ int label_surfaces(const cv::Mat& disp, const cv::Mat& member, float step,
 int label_surfaces_reference(const cv::Mat& disp, const cv::Mat& member, float step,
                              double bridge_rows_per_px, cv::Mat& labels);
 
+/// The velocity fit's residuals over a chain still short of its window (the first frames of a
+/// stream): what the data show of the fit's error, for pool_surface_motion's doubt.
+struct ChainResiduals {
+  /// CV_32FC(times_s.size()): per pixel with a velocity, Z minus its fitted line at each sample
+  /// time, m; NaN where its chain gave no sample (label_stereo_flow_rows' residuals). Empty: no
+  /// doubt.
+  cv::Mat residuals_m;
+  /// The sample times of the channels, s relative to now (0 = now, then the past frames, < 0).
+  std::vector<double> times_s;
+};
+
+/// The doubt of a surface's velocity: doubt_se standard errors of the slope of the line fitted
+/// to (times_s[j], residuals[j]) over the samples with a finite residual (the scatter of the
+/// surface's own positions about its fitted line), widened for few degrees of freedom as
+/// Student's t is (t_0.975(m - 2) / 1.96 for m samples; doubt_se 2: about 95 %), m/s when the
+/// residuals are m. Infinite with fewer than three samples (no scatter to measure yet) or when
+/// they all share one time.
+double slope_doubt(const std::vector<double>& times_s, const std::vector<double>& residuals,
+                   double doubt_se);
+
 /// Relabels a Stereo-Flow frame with pooled velocities. Surfaces are the 8-connected components
 /// of the pixels with a valid disparity (disp, CV_32F, invalid < 0), Z <= p.z_max_m and, with
 /// p.use_envelope_band, inside the envelope's vertical band now, where neighbours' disparities
@@ -65,14 +85,17 @@ int label_surfaces_reference(const cv::Mat& disp, const cv::Mat& member, float s
 /// gap's time: a motion too small to show over the gaps measured is noise, as at the start of a
 /// stream with gap 1 only); then heads_into_envelope(P, V, env, p.v_min_mps). Outputs,
 /// overwritten at every pixel: danger CV_8U 0/255, ttc CV_32F (s, NaN where safe), velocity =
-/// the surface's velocity (NaN elsewhere). All maps the same size. time_spread_s2 > 0 (a fit
-/// over a chain shorter than its window: sum (t - mean t)^2 of its sample times, s^2): the
-/// envelope test uses V (1 - sigma_V / -V_z) instead of V (nothing when that is <= 0), with
-/// sigma_V = (Z p.startup_doubt_px / d) / sqrt(time_spread_s2) at the pixel's depth; the TTC
-/// reported is that of V itself.
+/// the surface's velocity (NaN elsewhere). All maps the same size. With `startup` (a fit over a
+/// chain still short of its window), each surface is doubted by the scatter of its own fit: its
+/// mean residual at each sample time, over the pixels of the middle half of its V_z (those its
+/// interquartile mean averages), gives sigma_V = slope_doubt(startup.times_s, those means,
+/// p.startup_doubt_se), and the envelope test uses V (1 - sigma_V / -V_z) instead of V (nothing
+/// when that is <= 0; nothing either with fewer than three samples); the TTC reported is that of
+/// V itself. A large surface seen well is thus trusted from its first frames, a few pixels whose
+/// disparity steps are not.
 void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const core::Envelope& env,
                          const core::SceneFlowParams& p, double span_s, const cv::Mat& edges,
                          cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity,
-                         double time_spread_s2 = 0.0);
+                         const ChainResiduals& startup = {});
 
 }  // namespace sg::vision

@@ -21,27 +21,22 @@ struct SurfaceTest {
   double min_delta_d_px = 0.0;                ///< the noise gate's disparity growth, px
   double v_min_mps = 0.0;                     ///< heads_into_envelope's approach speed
   core::Envelope envelope;
-  /// A short chain's doubt (time_spread_s2 > 0): sigma_V = (Z startup_doubt_px / d) /
-  /// sqrt_time_spread; 0 = none.
-  double startup_doubt_px = 0.0;
-  double sqrt_time_spread = 0.0;
 };
 
 /// The test's constants for a frame (pool_surface_motion's arguments).
 SurfaceTest make_surface_test(const core::Camera& cam, const core::Envelope& env,
-                              const core::SceneFlowParams& p, double span_s,
-                              double time_spread_s2);
+                              const core::SceneFlowParams& p, double span_s);
 
 /// For x in [x0, x1) of row y, with disparities d[x] > 0 of one surface moving at V (m/s):
-/// ttc[x] = the TTC (s) when the noise gate and heads_into_envelope(P(x, y, d[x]), V keep) pass
-/// (keep = 1 - sigma_V / -V_z with a short chain's doubt and V_z < 0, else 1; keep must be > 0),
-/// NaN otherwise. Only ttc[x0, x1) is written.
-void test_surface_run(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
+/// ttc[x] = the TTC of V (s, t_c keep) when the noise gate (with V) and
+/// heads_into_envelope(P(x, y, d[x]), V keep) pass, NaN otherwise. keep in (0, 1]: the share of
+/// V that the surface's doubt leaves (1: none). Only ttc[x0, x1) is written.
+void test_surface_run(const SurfaceTest& k, const cv::Vec3d& V, double keep, int y, int x0, int x1,
                       const float* d, float* ttc);
 
 /// The same, one pixel at a time: the reference test_surface_run is tested against.
-void test_surface_run_reference(const SurfaceTest& k, const cv::Vec3d& V, int y, int x0, int x1,
-                                const float* d, float* ttc);
+void test_surface_run_reference(const SurfaceTest& k, const cv::Vec3d& V, double keep, int y,
+                                int x0, int x1, const float* d, float* ttc);
 
 /// The SIMD target test_surface_run runs on this machine (e.g. "AVX3").
 std::string surface_test_target();
