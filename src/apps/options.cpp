@@ -149,32 +149,6 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                "split optical flow into the T tiles too (faster, not bit-identical)");
 }
 
-namespace {
-
-/// The camera-derived defaults (core::adapt_to_camera) for the envelope and settings the config
-/// file will give, written into `params` before the file and the flags, which still override them.
-void fit_to_camera(const std::string& config, const core::Camera& camera,
-                   core::DetectorParams& params) {
-  core::DetectorParams derived = params;
-  if (!config.empty()) {
-    io::RunSettings ignored;
-    io::apply_config_file(config, derived, ignored);
-  }
-  core::adapt_to_camera(derived, camera);
-  params.bm.num_disparities = derived.bm.num_disparities;
-  params.signal.min_area_px = derived.signal.min_area_px;
-  params.signal.region_min_px = derived.signal.region_min_px;
-  params.scene_flow.edge_margin_px = derived.scene_flow.edge_margin_px;
-  params.stereo.gaps = derived.stereo.gaps;
-  params.scene_flow.gaps = derived.scene_flow.gaps;
-  params.signal.on_k = derived.signal.on_k;
-  params.signal.on_n = derived.signal.on_n;
-  params.signal.off_m = derived.signal.off_m;
-  params.signal.severity_off_frames = derived.signal.severity_off_frames;
-}
-
-}  // namespace
-
 core::CameraFit camera_fit(const pipeline::RunOptions& options, const core::Camera& camera) {
   core::DetectorParams derived = options.params;
   const core::CameraFit wanted = core::adapt_to_camera(derived, camera);
@@ -203,7 +177,12 @@ pipeline::RunOptions make_run_options(const DetectorOptions& o,
   // run and eval recommend Stereo-Flow: Stereo mode alarms on whatever passes by (crossing,
   // ego-pass, turning). A config file's detector.mode or --mode picks the other.
   run.params.mode = core::Mode::kStereoFlow;
-  if (camera) fit_to_camera(o.config, *camera, run.params);
+  if (camera) {
+    // The camera-derived defaults, for the contact plane (and range, gaps) the config file gives;
+    // the file is applied again below, so that the values it sets itself win over derived ones.
+    if (!o.config.empty()) io::apply_config_file(o.config, run.params, settings);
+    core::adapt_to_camera(run.params, *camera);
+  }
   if (!o.config.empty()) io::apply_config_file(o.config, run.params, settings);
   if (settings_out) *settings_out = settings;
   run.pace_fps = settings.pace_fps;

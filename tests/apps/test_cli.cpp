@@ -258,6 +258,9 @@ TEST_F(Cli, ScenarioPlatformIsAppliedUnlessAFlagOrConfigSaysOtherwise) {
   EXPECT_NE(first_line("--platform robot").find("depth 0.39-20 m"), std::string::npos);
   std::ofstream(dir_ / "robot.yaml") << "platform: robot\n";
   EXPECT_NE(first_line("--config robot.yaml").find("depth 0.39-20 m"), std::string::npos);
+  // A config key wins over the derived value (f B / 47 = 0.26 m).
+  std::ofstream(dir_ / "range.yaml") << "stereo: {num_disparities: 48}\n";
+  EXPECT_NE(first_line("--config range.yaml").find("depth 0.26-60 m"), std::string::npos);
   std::ofstream(dir_ / "car.yaml") << "platform: car\n";
   expect_user_error(run("eval --scenario narrow.yaml --config car.yaml --platform walker "
                         "--num-disparities 256"),
