@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
@@ -171,12 +170,7 @@ void eval_flow_main(const EvalArgs& args) {
                   s.second / n);
     }
   std::fflush(stdout);
-  if (!args.json.empty()) {
-    std::ofstream out(args.json);
-    if (!out) throw core::InputError("cannot write " + args.json);
-    out << nlohmann::json{{"flow", rows}}.dump(2) << "\n";
-    std::cout << "json              " << args.json << "\n";
-  }
+  if (!args.json.empty()) write_json_output(args.json, nlohmann::json{{"flow", rows}});
 }
 
 void eval_main(const EvalArgs& args) {
@@ -263,16 +257,13 @@ void eval_main(const EvalArgs& args) {
   std::cout << ")\n"
             << result.report.table();
   if (!args.json.empty()) {
-    std::ofstream out(args.json);
-    if (!out) throw core::InputError("cannot write " + args.json);
     nlohmann::json j = result.report.to_json();
     j["input"] = in.name;
     j["mode"] = core::to_string(options.params.mode);
     const bool flow_mode = options.params.mode == core::Mode::kStereoFlow;
     j["gaps"] = flow_mode ? options.params.scene_flow.gaps : options.params.stereo.gaps;
     if (flow_mode) j["flow_method"] = core::to_string(options.params.flow.method);
-    out << j.dump(2) << "\n";
-    std::cout << "json              " << args.json << "\n";
+    write_json_output(args.json, j);
   }
   frame_outputs.finish(std::cout);
 }

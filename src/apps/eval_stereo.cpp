@@ -1,13 +1,13 @@
 #include "eval_stereo.hpp"
 
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
 #include <sstream>
 
+#include "outputs.hpp"
 #include "sg/core/error.hpp"
 #include "sg/pipeline/stereo_evaluation.hpp"
 
@@ -102,12 +102,8 @@ void eval_stereo_main(const StereoEvalArgs& args) {
     print_row("mean", m.label, 0, mean, ms);
     means.push_back(to_json("mean", m.label, 0, m.params.block_size, mean, ms));
   }
-  if (!args.json.empty()) {
-    std::ofstream out(args.json);
-    if (!out) throw core::InputError("cannot write " + args.json);
-    out << nlohmann::json{{"stereo", rows}, {"mean", means}}.dump(2) << "\n";
-    std::cout << "json         " << args.json << "\n";
-  }
+  if (!args.json.empty())
+    write_json_output(args.json, nlohmann::json{{"stereo", rows}, {"mean", means}}, 13);
 }
 
 }  // namespace sg::apps

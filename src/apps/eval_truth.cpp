@@ -1,7 +1,6 @@
 #include "eval_truth.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -40,13 +39,6 @@ nlohmann::json criteria_json(const eval::TruthCriteria& c, const eval::TruthLog&
           {"distance_column", log.distance_column},
           {"min_closing_mps", c.min_closing_mps},
           {"fit_half_window_s", c.fit_half_window_s}};
-}
-
-void write_json(const std::string& path, const nlohmann::json& j) {
-  std::ofstream out(path);
-  if (!out) throw core::InputError("cannot write " + path);
-  out << j.dump(2) << "\n";
-  std::cout << "json              " << path << "\n";
 }
 
 }  // namespace
@@ -134,7 +126,7 @@ void eval_truth_main(const TruthEvalArgs& args) {
   j["detector"] = baseline ? kCentralMedian : "stereoguard";
   j["mode"] = baseline ? kCentralMedian : core::to_string(options.params.mode);
   j["throughput_fps"] = summary.throughput_fps;
-  if (!args.json.empty()) write_json(args.json, j);
+  if (!args.json.empty()) write_json_output(args.json, j);
   frame_outputs.finish(std::cout);
 }
 

@@ -1,6 +1,10 @@
 #include "outputs.hpp"
 
+#include <algorithm>
+#include <fstream>
 #include <iostream>
+
+#include "sg/core/error.hpp"
 
 namespace sg::apps {
 
@@ -49,6 +53,14 @@ void FrameOutputs::finish(std::ostream& out) {
   if (progress_) progress_->finish();
   if (csv_) out << "csv               " << outputs_.csv << " (" << frames_ << " rows)\n";
   if (dump_) out << "dump              " << outputs_.dump << "/ (" << frames_ << " frames)\n";
+}
+
+void write_json_output(const std::string& path, const nlohmann::json& j, int column) {
+  std::ofstream out(path);
+  if (!out) throw core::InputError("cannot write " + path);
+  out << j.dump(2) << "\n";
+  std::cout << std::string("json") + std::string(static_cast<size_t>(std::max(1, column - 4)), ' ')
+            << path << "\n";
 }
 
 }  // namespace sg::apps

@@ -2,6 +2,7 @@
 /// Per-frame outputs of `run` and `eval` beside the events: --csv, --dump, the progress bar, and
 /// --scale (run only: the ground truth of eval is not rescaled).
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -22,6 +23,11 @@ struct OutputOptions {
 
 /// Adds --csv, --dump and, when `with_scale`, --scale.
 void add_output_options(CLI::App& app, OutputOptions& options, bool with_scale);
+
+/// Writes `j` (indented) to `path` (an eval --json file) and names it on stdout in a line
+/// "json" padded to `column`, the value column of the command's table. Throws InputError when
+/// the file cannot be written.
+void write_json_output(const std::string& path, const nlohmann::json& j, int column = 18);
 
 /// Flags over the config file's settings.
 struct ResolvedOutputs {
