@@ -128,9 +128,11 @@ TEST(Params, HysteresisAndSeverityRules) {
   s.on_k = 4;
   s.on_n = 3;
   s.ttc_warning_s = 1.0;
+  s.confirm_frames = 0;
   const auto problems = validate(s);
   EXPECT_TRUE(mentions(problems, "signal.on_k=4"));
   EXPECT_TRUE(mentions(problems, "signal.ttc_warning_s=1"));
+  EXPECT_TRUE(mentions(problems, "signal.confirm_frames=0"));
 }
 
 TEST(Params, ThrowIfInvalidJoinsProblems) {
