@@ -150,6 +150,29 @@ bool near_depth_edge(const cv::Mat& disp, int x, int y, int r, float step) {
 
 }  // namespace
 
+ChainStrides::ChainStrides(const core::Camera& cam, const SceneFlowParams& p)
+    : stride_(p.pool_surface_motion ? p.chain_stride : 1),
+      d_stride_(stride_ > 1 ? static_cast<float>(cam.focal_px * cam.baseline_m / p.chain_stride_z_m)
+                            : std::numeric_limits<float>::infinity()) {}
+
+cv::Size ChainStrides::at(float d) const {
+  if (!(d >= d_stride_)) return {1, 1};
+  // Each sqrt(2) nearer doubles one of the two strides, columns first, then rows: an object's
+  // pixels grow as 1 / Z^2, the ones followed stay about as many at every distance, not only at
+  // each halving. (Rows first raised the false alarms of the thin pole, a column few pixels wide,
+  // from 0.014 to 0.027.)
+  int sx = stride_;
+  int sy = stride_;
+  for (float next = kSqrt2 * d_stride_; d >= next && sx < kMaxChainStride; next *= kSqrt2) {
+    if (sy == sx) {
+      sx *= 2;
+    } else {
+      sy *= 2;
+    }
+  }
+  return {sx, sy};
+}
+
 void mark_depth_edges(const cv::Mat& disp, int margin_px, double step_px, cv::Mat& mask) {
   if (disp.type() != CV_32FC1) throw core::InputError("depth edges: disparity must be CV_32F");
   mask.create(disp.size(), CV_8UC1);
@@ -340,29 +363,9 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
   };
 
   const float d_min = static_cast<float>(cam.focal_px * cam.baseline_m / p.z_max_m);
-  // Nearer than chain_stride_z_m only every stride-th row and column is followed (pooling gives
-  // the others their surface's velocity); each sqrt(2) nearer doubles one of the two strides,
-  // columns first, then rows: an object's pixels grow as 1 / Z^2, the ones followed stay about as
-  // many at every distance, not only at each halving. (Rows first raised the false alarms of the
-  // thin pole, a column few pixels wide, from 0.014 to 0.027.) By absolute row and column, so
-  // tiles follow the same pixels.
-  const int stride = p.pool_surface_motion ? p.chain_stride : 1;
-  const float d_stride =
-      stride > 1 ? static_cast<float>(cam.focal_px * cam.baseline_m / p.chain_stride_z_m)
-                 : std::numeric_limits<float>::infinity();
-  auto followed = [stride, d_stride](int x, int y, float d) {
-    if (d < d_stride) return true;
-    int sx = stride;
-    int sy = stride;
-    for (float next = kSqrt2 * d_stride; d >= next && sx < kMaxChainStride; next *= kSqrt2) {
-      if (sy == sx) {
-        sx *= 2;
-      } else {
-        sy *= 2;
-      }
-    }
-    return y % sy == 0 && x % sx == 0;
-  };
+  // Nearer than chain_stride_z_m only a grid of pixels is followed (pooling gives the others
+  // their surface's velocity). By absolute row and column, so tiles follow the same pixels.
+  const ChainStrides strides(cam, p);
   auto in_band = [&cam, &env](int y, float d) {
     const double Y = (y - cam.cy) * cam.baseline_m / d;  // (y - cy) * Z / f
     return Y >= env.y_top_m && Y <= env.y_bottom_m;
@@ -391,7 +394,7 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
       ttc_row[x] = kNaN;
       vel_row[x] = unknown;
       if (d_row[x] > 0.0f && d_row[x] >= d_min && edge_row[x] == 0 &&
-          followed(x, y, d_row[x]) &&
+          strides.followed(x, y, d_row[x]) &&
           (!p.use_envelope_band || in_band(y, d_row[x]))) {
         q[x] = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
         live.push_back(x);

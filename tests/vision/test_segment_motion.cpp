@@ -310,6 +310,73 @@ TEST(InterquartileMean, AgreesWithTheSortingReference) {
   EXPECT_NEAR(by_sort(big), -1.4, 0.01);
 }
 
+// A value of weight w counts as w copies: the weighted mean equals the plain interquartile mean
+// of the repeated values, and low / high bound that mean's middle ranks, on sizes 1 to 40 with
+// weights of stride cells (1 to 256) and quantized values with ties; unit weights give the plain
+// mean.
+TEST(WeightedInterquartileMean, EqualsTheMeanOfTheRepeatedValues) {
+  cv::RNG rng(5);
+  std::vector<std::pair<float, int>> scratch;
+  for (int n = 1; n <= 40; ++n) {
+    std::vector<float> v(static_cast<size_t>(n));
+    std::vector<int> w(v.size()), ones(v.size(), 1);
+    std::vector<float> repeated;
+    for (size_t i = 0; i < v.size(); ++i) {
+      v[i] = static_cast<float>(std::round(rng.uniform(-3.0, 3.0) * 8) / 8);
+      w[i] = 1 << rng.uniform(0, 9);
+      repeated.insert(repeated.end(), static_cast<size_t>(w[i]), v[i]);
+    }
+    float low = kNaN, high = kNaN;
+    const float mean = weighted_interquartile_mean(v.data(), w.data(), v.size(), scratch, &low,
+                                                   &high);
+    std::sort(repeated.begin(), repeated.end());
+    const size_t q = repeated.size() / 4;
+    EXPECT_FLOAT_EQ(low, repeated[q]) << n;
+    EXPECT_FLOAT_EQ(high, repeated[repeated.size() - q - 1]) << n;
+    EXPECT_NEAR(mean, interquartile_mean(repeated), 1e-5) << n;
+    std::vector<float> copy = v;
+    EXPECT_NEAR(weighted_interquartile_mean(v.data(), ones.data(), v.size(), scratch),
+                interquartile_mean(copy), 1e-5)
+        << n;
+  }
+}
+
+// A surface that reaches from 17 m down to 1.25 m (a floor, a wall seen at a slant) whose
+// measured V_z drifts with depth: followed on ChainStrides' grid (every pixel far, one in up to
+// 128 near), it pools the velocity it pools with every pixel followed, where the grid's samples
+// counted once each would give the far part's.
+TEST(PoolSurfaceMotion, AStrideGridPoolsAsIfEveryPixelWereFollowed) {
+  core::SceneFlowParams p;
+  p.use_envelope_band = false;
+  ASSERT_GT(p.chain_stride, 1);
+  const core::Camera c = camera();
+  Maps full, grid;
+  const ChainStrides strides(c, p);
+  std::vector<float> samples;  // the grid's V_z, each counted once
+  for (int y = 0; y < c.height; ++y)
+    for (int x = 0; x < c.width; ++x) {
+      const float d = 3.0f + 37.0f * static_cast<float>(y) / static_cast<float>(c.height - 1);
+      const cv::Vec3f v(0.0f, 0.0f, static_cast<float>(-2.0 + 0.1 * c.depth(d)));
+      for (Maps* m : {&full, &grid}) m->disp.at<float>(y, x) = d;
+      full.velocity.at<cv::Vec3f>(y, x) = v;
+      if (strides.followed(x, y, d)) {
+        grid.velocity.at<cv::Vec3f>(y, x) = v;
+        samples.push_back(v[2]);
+      }
+    }
+  ASSERT_GT(strides.weight(40.0f), 64);  // the near rows are followed sparsely
+  core::SceneFlowParams every = p;
+  every.chain_stride = 1;  // every pixel followed: each its own weight
+  pool_surface_motion(full.disp, c, wide(), every, 2.0, full.edges, full.danger, full.ttc,
+                      full.velocity);
+  pool_surface_motion(grid.disp, c, wide(), p, 2.0, grid.edges, grid.danger, grid.ttc,
+                      grid.velocity);
+  const float every_pixel = full.velocity.at<cv::Vec3f>(60, 80)[2];
+  const float on_the_grid = grid.velocity.at<cv::Vec3f>(60, 80)[2];
+  EXPECT_NEAR(on_the_grid, every_pixel, 0.02 * std::abs(every_pixel));
+  EXPECT_GT(std::abs(interquartile_mean(samples) - every_pixel), 0.2);  // what weighting fixes
+}
+
 // The run-based union-find against the pixel-based reference: the same labels and count on
 // random maps of surfaces at several depths, with holes, noise below and above the step, thin
 // columns cut by stretches of other disparities, and with and without bridging.

@@ -267,6 +267,7 @@ struct SceneFlowParams {
   /// 4: a box between 4 and 8 m was followed at every pixel and made the costliest frames before
   /// contact (frames 100-119: 25-31 ms against 17 ms far; from 8 m: 21-25 ms), the tail that
   /// paced runs wait for; the eval figures stayed but for TTC p90 on thin-pole (0.037 -> 0.054).
+  /// pool_surface_motion weighs each followed pixel by the pixels of its cell (ChainStrides).
   int chain_stride = 2;
   double chain_stride_z_m = 8.0;
   /// Grow each dangerous blob back over the depth-edge margin (pixels of similar disparity next

@@ -99,6 +99,31 @@ struct GapSource {
 /// CV_32FC3), so that row tiles can then fill them independently.
 void allocate_stereo_flow_outputs(cv::Size size, cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity);
 
+/// The grid of pixels label_stereo_flow_rows follows back along the chain when
+/// p.pool_surface_motion and p.chain_stride > 1 (SceneFlowParams::chain_stride): every pixel
+/// farther than p.chain_stride_z_m, nearer only every sx-th column and sy-th row by absolute
+/// position, (sx, sy) = (chain_stride, chain_stride) doubled once per factor sqrt(2) nearer,
+/// columns first, up to 16 each.
+class ChainStrides {
+ public:
+  ChainStrides(const core::Camera& cam, const SceneFlowParams& p);
+  /// (sx, sy) at disparity d: (1, 1) where every pixel is followed.
+  cv::Size at(float d) const;
+  /// Whether pixel (x, y) with disparity d is followed.
+  bool followed(int x, int y, float d) const {
+    const cv::Size s = at(d);
+    return x % s.width == 0 && y % s.height == 0;
+  }
+  /// The pixels a followed pixel with disparity d stands for, sx * sy: pool_surface_motion
+  /// weighs its velocity by them, so that the near part of a surface, followed sparsely, counts
+  /// as much as its far part.
+  int weight(float d) const { return at(d).area(); }
+
+ private:
+  int stride_ = 1;
+  float d_stride_;  ///< the disparity of chain_stride_z_m; +inf: every pixel followed
+};
+
 /// The per-pixel test of label_stereo_flow_window on output rows `rows` only (cv::Range::all():
 /// every row), for past frames given explicitly: flows[j] is the backward flow of the j-th newest
 /// frame of the chain (flows[0] = B_i, from the current frame to the frame before it in the

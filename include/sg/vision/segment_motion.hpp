@@ -11,6 +11,7 @@
 /// envelope test: its noise then falls with the square root of the surface's pixel count.
 #include <cstddef>
 #include <opencv2/core.hpp>
+#include <utility>
 #include <vector>
 
 #include "sg/core/camera.hpp"
@@ -28,6 +29,16 @@ namespace sg::vision {
 float interquartile_mean(std::vector<float>& v);
 /// The same over v[0, n) (reordered; n > 0).
 float interquartile_mean(float* v, size_t n);
+
+/// Interquartile mean of v[0, n) (n > 0) where v[i] counts as w[i] >= 1 copies of itself (a
+/// followed pixel standing for the w[i] pixels of its stride cell, ChainStrides::weight):
+/// floor(W / 4) of the total weight W is trimmed from each end of the sorted values, a value on
+/// a border keeping the weight left of it. Equal to interquartile_mean of the values repeated
+/// w[i] times (up to a float rounding). low and high (optional): the smallest and the largest
+/// value kept. Sorts (value, weight) pairs in `scratch`.
+float weighted_interquartile_mean(const float* v, const int* w, size_t n,
+                                  std::vector<std::pair<float, int>>& scratch,
+                                  float* low = nullptr, float* high = nullptr);
 
 /// The surfaces of pool_surface_motion: labels (CV_32S, 0 = none, 1..count-1, numbered in the
 /// raster order of each surface's first pixel) the 8-connected components of the `member` pixels
