@@ -10,6 +10,7 @@
 #include "options.hpp"
 #include "sg/core/error.hpp"
 #include "sg/pipeline/bench.hpp"
+#include "sg/pipeline/runner.hpp"
 
 namespace sg::apps {
 namespace {
@@ -70,6 +71,35 @@ void print_recheck(const pipeline::BenchRow& r) {
               << " %: the machine's speed changed while the paced rows ran, so their pace may not "
                  "be the fraction asked for; run again";
   std::cout << ")" << std::endl;
+}
+
+/// Per detector and resolution: the W and T that `run` picks by default (--workers auto,
+/// --tiles auto, for `threads`) beside the fastest configuration swept.
+void print_auto(const std::vector<pipeline::BenchRow>& swept, int threads) {
+  const pipeline::AutoConfiguration automatic = pipeline::auto_configuration(threads);
+  std::vector<bool> told(swept.size(), false);
+  for (size_t i = 0; i < swept.size(); ++i) {
+    if (told[i]) continue;
+    const pipeline::BenchRow* best = nullptr;
+    const pipeline::BenchRow* picked = nullptr;
+    for (size_t j = i; j < swept.size(); ++j) {
+      const pipeline::BenchRow& r = swept[j];
+      if (r.mode != swept[i].mode || r.resolution != swept[i].resolution) continue;
+      told[j] = true;
+      if (!best || r.fps > best->fps) best = &r;
+      if (r.workers == automatic.workers && r.tiles == automatic.tiles) picked = &r;
+    }
+    std::cout << std::fixed << std::setprecision(1) << "(auto, run's default: " << best->mode
+              << " " << best->resolution.width << "x" << best->resolution.height << ", W "
+              << automatic.workers << " T " << automatic.tiles;
+    if (picked)
+      std::cout << ", " << picked->fps << " fps, " << 100.0 * picked->fps / best->fps
+                << " % of the fastest swept";
+    else
+      std::cout << " (not swept)";
+    std::cout << "; fastest: W " << best->workers << " T " << best->tiles << ", " << best->fps
+              << " fps)\n";
+  }
 }
 
 void write_plot(const std::string& csv, const std::string& png,
@@ -142,7 +172,9 @@ void bench_main(const BenchArgs& a) {
             << "(vs-mt: speedup against the plain loop with OpenCV's threads, the default a user "
                "gets; vs-1t: against the same loop on one thread)\n";
   std::string capacity_told;  // the mode whose capacity line was printed
+  std::vector<pipeline::BenchRow> swept;  // the unpaced pipeline rows, for the auto line
   pipeline::run_bench(config, [&](const pipeline::BenchRow& row) {
+    if (row.kind == "pipeline") swept.push_back(row);
     if (row.kind == "paced" && row.mode != capacity_told) {
       print_capacity(row);
       capacity_told = row.mode;
@@ -151,6 +183,7 @@ void bench_main(const BenchArgs& a) {
     if (row.kind == "recheck") print_recheck(row);
     csv << pipeline::to_csv(row) << "\n" << std::flush;
   });
+  print_auto(swept, a.threads);
   std::cout << "csv: " << a.csv << "\n";
   if (!a.plot.empty()) {
     csv.close();

@@ -141,8 +141,10 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                  "disparity range, depth limits); default: the scenario's");
   app.add_option("--fps", o.fps, "pace the input like a camera at this rate, Hz (0 = no pacing)");
   app.add_option("--workers", o.workers,
-                 "W: farm workers computing SM/OF tasks at once (default 1)");
-  app.add_option("--tiles", o.tiles, "T: row tiles per task (default 1)");
+                 "W: farm workers computing SM/OF tasks at once, or auto (default: auto, one per "
+                 "core)");
+  app.add_option("--tiles", o.tiles,
+                 "T: row tiles per task, or auto (default: auto, 2 on more than one core)");
   app.add_option("--tokens", o.tokens, "frames in flight (default 0: W + 1)");
   app.add_option("--threads", o.threads, "threads of the task arena (default 0 = all cores)");
   app.add_flag("--tile-flow", o.tile_flow,
@@ -208,10 +210,14 @@ pipeline::RunOptions make_run_options(const DetectorOptions& o,
   if (o.flow_method) run.params.flow.method = core::parse_flow_method(*o.flow_method);
   if (o.min_area) run.params.signal.min_area_px = *o.min_area;
   if (o.fps) run.pace_fps = *o.fps;
-  if (o.workers) run.workers = *o.workers;
-  if (o.tiles) run.tiles = *o.tiles;
+  if (o.workers) run.workers = io::parse_count_or_auto(*o.workers, "--workers");
+  if (o.tiles) run.tiles = io::parse_count_or_auto(*o.tiles, "--tiles");
   if (o.tokens) run.tokens = *o.tokens;
   if (o.threads) run.threads = *o.threads;
+  // auto: from the cores of the task arena (--threads); what ran is in the summary.
+  const pipeline::AutoConfiguration automatic = pipeline::auto_configuration(run.threads);
+  if (run.workers == io::kAuto) run.workers = automatic.workers;
+  if (run.tiles == io::kAuto) run.tiles = automatic.tiles;
   if (o.tile_flow) run.tile_flow = true;
   run.prefault_heap = true;  // main() keeps freed blocks on one heap
   return run;

@@ -56,7 +56,8 @@ struct DetectorOptions {
   std::optional<std::string> flow_method;
   std::optional<std::string> platform;
   std::optional<double> fps;
-  std::optional<int> workers, tiles, tokens, threads;
+  std::optional<std::string> workers, tiles;  ///< a positive integer or "auto"
+  std::optional<int> tokens, threads;
   bool tile_flow = false;
 };
 

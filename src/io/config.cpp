@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <charconv>
 #include <functional>
 #include <map>
 #include <optional>
@@ -66,6 +67,16 @@ class Section {
 
 }  // namespace
 
+int parse_count_or_auto(const std::string& text, const std::string& what) {
+  if (text == "auto") return kAuto;
+  int value = 0;
+  const char* end = text.data() + text.size();
+  const auto [at, error] = std::from_chars(text.data(), end, value);
+  if (error != std::errc() || at != end || value < 1)
+    throw core::InputError(what + " must be a positive integer or auto (got '" + text + "')");
+  return value;
+}
+
 std::optional<std::string> config_platform(const std::filesystem::path& path) {
   core::DetectorParams ignored;
   RunSettings settings;
@@ -91,12 +102,13 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
   try {
     if (!root.IsMap()) Section::fail("top level", "must be a map");
     std::string mode = core::to_string(p.mode);
+    std::string workers, tiles;
     Section(root, "config")
         .field("mode", mode)
         .field("detector", mode)
         .field("fps", settings.pace_fps)
-        .field("workers", settings.workers)
-        .field("tiles", settings.tiles)
+        .field("workers", workers)
+        .field("tiles", tiles)
         .field("tokens", settings.tokens)
         .field("threads", settings.threads)
         .field("scale", settings.scale)
@@ -116,6 +128,8 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .section("proximity")
         .section("input")
         .done();
+    if (!workers.empty()) settings.workers = parse_count_or_auto(workers, "config.workers");
+    if (!tiles.empty()) settings.tiles = parse_count_or_auto(tiles, "config.tiles");
     core::select_detector(p, core::parse_mode(mode));
     std::string matcher = core::to_string(p.bm.matcher), cost = core::to_string(p.bm.cost);
     Section(root["stereo"], "stereo")

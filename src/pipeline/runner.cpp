@@ -250,6 +250,11 @@ std::string format_ms(double v) {
 
 }  // namespace
 
+AutoConfiguration auto_configuration(int threads) {
+  const int cores = threads > 0 ? threads : par::default_threads();
+  return {std::max(1, cores), cores > 1 ? 2 : 1};
+}
+
 int effective_tokens(const RunOptions& o) {
   if (o.tokens > 0) return o.tokens;
   // One frame ready beyond the workers. A file's waits for a worker. A paced camera's is taken

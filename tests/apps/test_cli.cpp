@@ -286,6 +286,27 @@ TEST_F(Cli, RunAndEvalDefaultToStereoFlowUnlessAConfigOrFlagSaysStereo) {
   EXPECT_NE(r.out.find("stereo-flow"), std::string::npos) << r.out;
 }
 
+// W and T default to auto, from the cores of the task arena: one worker per core, two tiles on
+// more than one; a flag or config value wins, and the summary names what ran.
+TEST_F(Cli, WorkersAndTilesDefaultToTheCores) {
+  const fs::path scenario = small_scenario(3);
+  const auto ran = [&](const std::string& args) {
+    const Result r = run("run --scenario '" + scenario.string() + "' --summary s.json " + args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    const nlohmann::json c = nlohmann::json::parse(slurp(dir_ / "s.json"))["config"];
+    return std::make_pair(c["workers"].get<int>(), c["tiles"].get<int>());
+  };
+  EXPECT_EQ(ran("--threads 1"), std::make_pair(1, 1));
+  EXPECT_EQ(ran("--threads 3"), std::make_pair(3, 2));
+  EXPECT_EQ(ran("--threads 3 --workers 2 --tiles 1"), std::make_pair(2, 1));
+  std::ofstream(dir_ / "w.yaml") << "workers: 1\ntiles: auto\n";
+  EXPECT_EQ(ran("--threads 3 --config w.yaml"), std::make_pair(1, 2));
+  const auto [w, t] = ran("");  // all the cores this process may use
+  EXPECT_GE(w, 1);
+  EXPECT_EQ(t, w > 1 ? 2 : 1);
+  expect_user_error(run("run --scenario '" + scenario.string() + "' --workers many"), "--workers");
+}
+
 // Far approaches, where the per-frame disparity error of a small far surface is a tenth of its
 // growth over the chain: with the two-point velocity of the longest gap these alarmed 0.1 s
 // before the truth (false_alarm_rate 0.094 and 0.083); the velocity fit removed it.

@@ -42,6 +42,27 @@ TEST(Config, SetsOnlyTheGivenFields) {
   EXPECT_DOUBLE_EQ(p.envelope.horizon_s, defaults.envelope.horizon_s);
 }
 
+// workers and tiles: auto (the default) or a positive integer, in the file as on the command line.
+TEST(Config, WorkersAndTilesAreAutoOrAPositiveCount) {
+  EXPECT_EQ(parse_count_or_auto("auto", "--workers"), kAuto);
+  EXPECT_EQ(parse_count_or_auto("3", "--workers"), 3);
+  for (const char* bad : {"0", "-1", "2x", "", "AUTO", "1.5"})
+    EXPECT_NE(input_error_of([&] { parse_count_or_auto(bad, "--tiles"); }).find("--tiles"),
+              std::string::npos)
+        << bad;
+  ScratchDir dir;
+  core::DetectorParams p;
+  RunSettings s;
+  EXPECT_EQ(s.workers, kAuto);
+  EXPECT_EQ(s.tiles, kAuto);
+  apply_config_file(write_file(dir, "workers: 2\ntiles: auto\n"), p, s);
+  EXPECT_EQ(s.workers, 2);
+  EXPECT_EQ(s.tiles, kAuto);
+  EXPECT_NE(input_error_of([&] { apply_config_file(write_file(dir, "workers: 0\n"), p, s); })
+                .find("config.workers"),
+            std::string::npos);
+}
+
 TEST(Config, FlowAndSceneFlowSections) {
   ScratchDir dir;
   const auto path = write_file(dir,

@@ -9,11 +9,18 @@
 
 namespace sg::io {
 
+/// A `workers` or `tiles` value chosen from the cores (`auto`).
+inline constexpr int kAuto = 0;
+
+/// Parses a `workers` / `tiles` value: "auto" gives kAuto, a positive integer itself. Throws
+/// core::InputError naming `what` for anything else.
+int parse_count_or_auto(const std::string& text, const std::string& what);
+
 /// Settings of a config file that are not detector parameters.
 struct RunSettings {
   double pace_fps = 0.0;  ///< `fps:` pace the emitter, Hz (0 = as fast as possible)
-  int workers = 1;        ///< `workers:` W, farm workers
-  int tiles = 1;          ///< `tiles:` T, row tiles per task
+  int workers = kAuto;    ///< `workers:` W, farm workers (`auto`: pipeline::auto_configuration)
+  int tiles = kAuto;      ///< `tiles:` T, row tiles per task (`auto`: the same)
   int tokens = 0;         ///< `tokens:` frames in flight (0 = automatic)
   int threads = 0;        ///< `threads:` task-arena size (0 = all cores)
   /// `input:` section: left, right, sbs, sbs_camera, kitti, kitti_color, euroc, camera [I, J],

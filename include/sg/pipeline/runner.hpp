@@ -46,6 +46,18 @@ struct RunOptions {
   bool prefault_heap = false;
 };
 
+/// The W and T that `--workers auto` and `--tiles auto` (the CLI's defaults) pick for a task
+/// arena of `threads` threads (0 = all the cores this process may use, par::default_threads()):
+/// W = the threads, one farm task on each; T = 2 with more than one thread, so that a worker
+/// whose frame's flow waits on the other core still splits its stereo matching (on 2 cores
+/// `bench` measured W 2 T 2 the fastest of W 1-3 x T 1-4 in both detectors; docs/performance.md).
+/// Every W and T give the same detections.
+struct AutoConfiguration {
+  int workers = 1;
+  int tiles = 1;
+};
+AutoConfiguration auto_configuration(int threads = 0);
+
 /// The heap a run of `options` holds at most for a camera of `width` x `height` px, roughly:
 /// the history (disparity, and flow and depth edges in Stereo-Flow mode, for the longest gap)
 /// and every frame in flight with its maps and labelling outputs. Bytes.
