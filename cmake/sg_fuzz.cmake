@@ -1,4 +1,4 @@
-# libFuzzer targets (option SG_FUZZ, clang only; see the `fuzz` preset and tests/fuzz/README.md).
+# libFuzzer targets (option SG_FUZZ, clang only; see the `fuzz` preset and docs/reliability.md).
 # Every stereoguard library is then built with -fsanitize=fuzzer-no-link,address,undefined (see
 # sg_target_options.cmake); each target links libFuzzer's main and is registered with CTest.
 set(SG_FUZZ_RUNS 20000 CACHE STRING "Executions per fuzz target in its CTest test (label fuzz)")

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Whole-process benchmark on a stereo folder (README "Performance"): the plain loop a user would
+# Whole-process benchmark on a stereo folder (docs/performance.md): the plain loop a user would
 # write (build/release/plain_loop: imread, StereoBM, DIS ultrafast, a one-gap labelling, OpenCV's
 # default threads) against `stereoguard run --input DIR --workers 2`, in both modes, and with
 # `--matcher fast`. Every command runs as its own process, RUNS rounds, the commands in a rotated

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Every performance figure of issue 8 in one go, on a quiet machine (README "Performance"):
+# Every performance figure of issue 8 in one go, on a quiet machine (docs/performance.md):
 #   1. collector busy time, Stereo-Flow, 640x480 head-on folder, W 1 and 2 (summary JSON);
 #   2. bench at 640x480 against opencv-mt in the same run, with the paced rows (80 %, 150 %),
 #      StereoBM and --matcher fast;

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Scores every detector on every built-in scenario and prints a markdown table (README figures).
+# Scores every detector on every built-in scenario and prints a markdown table (docs/detectors.md).
 # Usage: [DETECTORS="stereo stereo-flow ..."] scripts/eval_all.sh [path/to/stereoguard]
 # DETECTORS defaults to all seven (about 25 min on 2 cores; relative-size is the slowest).
 set -euo pipefail

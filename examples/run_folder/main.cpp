@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
 
     const sg::pipeline::RunSummary summary = sg::pipeline::run(
         source, options, [](const sg::core::StereoFrame&, const sg::core::Detection& d) {
-          // Called in frame order. Fields: README "Outputs", or include/sg/core/detection.hpp.
+          // Called in frame order. Fields: docs/outputs.md, or include/sg/core/detection.hpp.
           std::cout << sg::io::detection_to_json(d, /*timing=*/false).dump() << "\n";
         });
     std::cerr << summary.text();

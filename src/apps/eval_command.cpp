@@ -312,7 +312,7 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--dir", args->dir,
                   "with --flow: a folder of pairs (NAME1/NAME2.png + NAME.flo, or "
                   "ID-img0/ID-img1 + ID-gt.flo), and its subfolders; with --stereo: a stereo GT "
-                  "dataset (Middlebury, KITTI layouts; see README)");
+                  "dataset (Middlebury, KITTI layouts; see docs/detectors.md)");
   cmd->add_flag("--stereo", args->stereo,
                 "stereo accuracy instead: bad-1/2/4 %, MAE, density per matcher against GT "
                 "disparity (--dir DATASET, or --left/--right/--gt)")

@@ -12,7 +12,7 @@ namespace sg::apps {
 void add_input_options(CLI::App& app, InputOptions& options, bool left_right) {
   auto* scenario = app.add_option("--scenario", options.scenario,
                                   "built-in scenario name or scenario YAML file");
-  auto* input = app.add_option("--input", options.input, "stereo folder (see README)");
+  auto* input = app.add_option("--input", options.input, "stereo folder (see docs/inputs.md)");
   scenario->excludes(input);
   add_source_options(app, options, left_right);
 }

@@ -1,5 +1,5 @@
 // `plain_loop`: the program a user would write instead of `stereoguard run` on a stereo folder
-// (README "Stereo folder"), as the whole-process baseline of scripts/bench_process.sh. One frame
+// (docs/inputs.md), as the whole-process baseline of scripts/bench_process.sh. One frame
 // at a time: cv::imread of both PNGs, StereoBM, DIS ultrafast (Stereo-Flow), the labelling, with
 // OpenCV's default threads; no pipeline. Prints the frames, alarm frames and the wall time.
 #include "sg/pipeline/plain_loop.hpp"

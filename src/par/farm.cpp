@@ -264,7 +264,7 @@ void run_graph(const FarmConfig& config, const FarmCallbacks& cb) {
   // admission was configured, the farm's queue behind every task queued there, even while
   // admit_just_in_time() answered no: a paced run took its next frame 2.7 ms after the token
   // came back at the median and up to 24 ms (a task later), and lost it when that was past the
-  // next capture (README, Performance, "A freed token takes the next frame at once").
+  // next capture (docs/performance.md, "A freed token takes the next frame at once").
   flow::receiver<std::size_t>* first_stop = nullptr;  // the gate (paced) or the start
   auto emit_one = [&](bool counted) {
     // `counted`: whoever gave leave counted the item's first round already (so that two leaves

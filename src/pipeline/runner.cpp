@@ -151,7 +151,7 @@ class Emitter {
   int emitted_ = 0, dropped_ = 0;
   /// From 0, so that the first frames are taken just in time too: with W + 1 tokens a camera
   /// that outpaces the pipeline otherwise fills every token before its first loss (bench at 150 %
-  /// of capacity: median p99 2.39 instead of 2.59 service times; README, Performance).
+  /// of capacity: median p99 2.39 instead of 2.59 service times; docs/performance.md).
   int frames_since_loss_ = 0;
   std::atomic<bool> behind_{false};
   int lost_ = 0, last_index_ = -1;
@@ -260,9 +260,9 @@ int effective_tokens(const RunOptions& o) {
   // One frame ready beyond the workers. A file's waits for a worker. A paced camera's is taken
   // as soon as a token frees and held until its capture (FarmConfig::not_before), so it starts
   // when a worker frees rather than when the frame two before it is done; with W tokens a run
-  // of costly frames made each frame wait after its capture until one was lost (README,
-  // Performance). Once the camera outpaces the pipeline, frames are taken just in time instead
-  // (FarmConfig::admit_just_in_time), so the extra token does not make them wait.
+  // of costly frames made each frame wait after its capture until one was lost
+  // (docs/performance.md). Once the camera outpaces the pipeline, frames are taken just in time
+  // instead (FarmConfig::admit_just_in_time), so the extra token does not make them wait.
   return o.workers + 1;
 }
 
@@ -329,7 +329,7 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   // is the freshest (its latency counts from its capture), not as soon as a token frees, when it
   // would wait behind the older frames' stereo and flow. At 150 % of capacity: a median latency
   // of 1.7-1.8 service times instead of 2.2-2.3, at up to about 8 % fewer frames processed
-  // (README, Performance). A file read as fast as possible has no capture time to age from.
+  // (docs/performance.md). A file read as fast as possible has no capture time to age from.
   if (options.pace_fps > 0 || source.live())
     farm.admit_just_in_time = [&emitter] { return emitter.falling_behind(); };
   if (options.pace_fps > 0) farm.not_before = [&emitter] { return emitter.acquired(); };

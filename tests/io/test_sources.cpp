@@ -377,7 +377,7 @@ TEST(Euroc, RectificationAlignsRowsOfOrbMatches) {
   const StereoCalibration calib =
       read_euroc_calibration(mav0 / "cam0" / "sensor.yaml", mav0 / "cam1" / "sensor.yaml");
   EXPECT_EQ(calib.image_size, cv::Size(752, 480));
-  EXPECT_NEAR(cv::norm(calib.T), 0.11, 0.01);  // the README's "about 11 cm"
+  EXPECT_NEAR(cv::norm(calib.T), 0.11, 0.01);  // docs/inputs.md: "about 0.11 m"
   auto rectified = open_euroc(euroc_dir());
   EXPECT_EQ(rectified->size(), 95);
   EXPECT_NEAR(rectified->camera().fps, 20.0, 0.01);

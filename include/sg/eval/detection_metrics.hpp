@@ -1,5 +1,5 @@
 #pragma once
-/// Detection accuracy against ground truth (README "eval").
+/// Detection accuracy against ground truth (docs/outputs.md, "Evaluation").
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>

@@ -1,5 +1,5 @@
 #pragma once
-/// Optical-flow accuracy against ground truth (README "eval"; Middlebury conventions).
+/// Optical-flow accuracy against ground truth (docs/stereo-flow.md; Middlebury conventions).
 #include <opencv2/core.hpp>
 
 namespace sg::eval {

@@ -1,5 +1,5 @@
 #pragma once
-/// Stereo calibration files and rectification (README "Calibration").
+/// Stereo calibration files and rectification (docs/inputs.md, "Calibration").
 ///
 /// Conventions are OpenCV's (stereoCalibrate / stereoRectify): M1, M2 are 3x3 camera matrices, D1,
 /// D2 distortion coefficients (radial-tangential, 4, 5, 8, 12 or 14 numbers), and a point X1 in the

@@ -1,5 +1,5 @@
 #pragma once
-/// The YAML configuration file: mirrors the command-line flags (README "Configuration").
+/// The YAML configuration file: mirrors the command-line flags (docs/usage.md, "The config file").
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -40,7 +40,7 @@ std::optional<std::string> config_platform(const std::filesystem::path& path);
 
 /// Overwrites the fields of `params` (and `settings`) that the file sets; others keep their value.
 /// Sections: mode, fps, stereo, label, envelope, signal, flow, scene_flow (with scene_flow.ground)
-/// (see README and docs/stereo-flow.md). Throws core::InputError
+/// (see docs/usage.md and docs/stereo-flow.md). Throws core::InputError
 /// naming the file and the key for a missing file, bad YAML, an unknown key or a wrong type.
 /// Does not validate the values: call core::validate afterwards.
 void apply_config_file(const std::filesystem::path& path, core::DetectorParams& params,

@@ -1,5 +1,5 @@
 #pragma once
-/// Frame sources for real inputs (README "Inputs"): image pairs (two folders, two glob patterns,
+/// Frame sources for real inputs (docs/inputs.md): image pairs (two folders, two glob patterns,
 /// KITTI raw, EuRoC), videos and V4L2 cameras (two, or one side-by-side), and the rectifying
 /// decorator that wraps any of them.
 ///

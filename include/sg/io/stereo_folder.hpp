@@ -1,5 +1,5 @@
 #pragma once
-/// The stereo folder (README "Stereo folder"):
+/// The stereo folder (docs/inputs.md, "The stereo folder"):
 ///   DIR/camera.yaml   focal_px, baseline_m, cx, cy, fps (required numbers); width/height may be
 ///                     present but are informational: readers take them from the images.
 ///   DIR/left/*.png, DIR/right/*.png   sorted by file name; only .png files count; equal counts and

@@ -27,8 +27,8 @@ struct RunOptions {
   int workers = 1;  ///< W >= 1: farm tasks (SM, OF) running at once
   int tiles = 1;    ///< T >= 1: row tiles per task
   /// Frames in flight; 0 = automatic: W + 1, one frame ready beyond the workers (paced, it is
-  /// held until its capture, so a run of costly frames delays it instead of losing it; README,
-  /// Performance, has the paced figures against W tokens).
+  /// held until its capture, so a run of costly frames delays it instead of losing it;
+  /// docs/performance.md has the paced figures against W tokens).
   int tokens = 0;
   int threads = 0;  ///< task-arena size; 0 = all cores
   /// Split the optical-flow task into tiles too. Off by default: DIS works on an image pyramid,

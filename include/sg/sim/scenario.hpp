@@ -77,9 +77,10 @@ struct Scenario {
   /// A camera pixel integrates the light over its area: with edge_samples > 1 a pixel where a
   /// surface ends (its centre ray hits another surface or face than a 4-neighbour's) is shaded
   /// as the mean of edge_samples x edge_samples rays spread over the pixel, 1..8; 1 = one ray
-  /// through the centre (point sampling, the default, which the detection figures of the README
-  /// are measured with). Point sampling snaps silhouettes to whole pixels, so a thin pole's
-  /// matched disparity steps instead of growing smoothly as it nears (README, Scenarios).
+  /// through the centre (point sampling, the default, which the detection figures of
+  /// docs/detectors.md are measured with). Point sampling snaps silhouettes to whole pixels,
+  /// so a thin pole's matched disparity steps instead of growing smoothly as it nears
+  /// (docs/inputs.md, Scenarios).
   int edge_samples = 1;
   std::vector<Box> obstacles;
   core::Envelope envelope;                ///< for the ground-truth collision test
