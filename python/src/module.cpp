@@ -73,7 +73,8 @@ cv::Mat gray_image(const py::array& array, const char* name) {
                           shape_text(array));
   }
   const auto contiguous = py::array_t<std::uint8_t, py::array::c_style>::ensure(array);
-  const int rows = static_cast<int>(contiguous.shape(0)), cols = static_cast<int>(contiguous.shape(1));
+  const int rows = static_cast<int>(contiguous.shape(0));
+  const int cols = static_cast<int>(contiguous.shape(1));
   const cv::Mat view(rows, cols, array.ndim() == 2 ? CV_8UC1 : CV_8UC3,
                      const_cast<std::uint8_t*>(contiguous.data()));
   cv::Mat gray;
@@ -96,9 +97,10 @@ py::object share_map(const cv::Mat& mat) {
   if (mat.channels() == 1) {
     return py::array_t<float>({mat.rows, mat.cols}, {step, f}, mat.ptr<float>(), keep);
   }
+  const py::ssize_t channels = mat.channels();
   return py::array_t<float>({static_cast<py::ssize_t>(mat.rows), static_cast<py::ssize_t>(mat.cols),
-                             static_cast<py::ssize_t>(mat.channels())},
-                            {step, f * mat.channels(), f}, mat.ptr<float>(), keep);
+                             channels},
+                            {step, f * channels, f}, mat.ptr<float>(), keep);
 }
 
 std::optional<std::string> optional_string(const py::object& o) {
@@ -147,7 +149,9 @@ class Detector {
     return to_python(event);
   }
 
-  py::object disparity() const { return detector_ ? share_map(detector_->disparity()) : py::none(); }
+  py::object disparity() const {
+    return detector_ ? share_map(detector_->disparity()) : py::none();
+  }
   py::object flow() const { return detector_ ? share_map(detector_->flow()) : py::none(); }
 
  private:
@@ -162,7 +166,9 @@ class Detector {
       }
     }
     for (const char* required : {"focal_px", "baseline_m"}) {
-      if (!d.contains(required)) throw core::InputError(std::string("camera.") + required + ": missing");
+      if (!d.contains(required)) {
+        throw core::InputError(std::string("camera.") + required + ": missing");
+      }
     }
     camera_.focal_px = d["focal_px"].cast<double>();
     camera_.baseline_m = d["baseline_m"].cast<double>();
@@ -170,7 +176,8 @@ class Detector {
     if (d.contains("cy")) cy_ = d["cy"].cast<double>();
     if (d.contains("fps")) camera_.fps = d["fps"].cast<double>();
     if (d.contains("width") != d.contains("height")) {
-      throw core::InputError("camera: give width and height together, or neither (the first frame's size is taken)");
+      throw core::InputError(
+          "camera: give width and height together, or neither (the first frame's size is taken)");
     }
     if (d.contains("width")) {
       camera_.width = d["width"].cast<int>();

@@ -64,7 +64,8 @@ struct DetectorOptions {
 /// settings (outputs, scale). With `camera`, the defaults that depend on it
 /// (core::adapt_to_camera: disparity range, pixel sizes, frame gaps) come after the platform
 /// preset, before the config file and the options.
-RunOptions make_run_options(const DetectorOptions& options, const std::string& default_platform = "",
+RunOptions make_run_options(const DetectorOptions& options,
+                            const std::string& default_platform = "",
                             io::RunSettings* settings = nullptr,
                             const core::Camera* camera = nullptr);
 
