@@ -14,7 +14,6 @@
 #include "sg/core/error.hpp"
 #include "sg/io/events.hpp"
 #include "sg/io/overlay.hpp"
-#include "sg/io/scaled_source.hpp"
 
 namespace sg::apps {
 namespace {
@@ -67,16 +66,13 @@ class WarningPrinter {
 };
 
 void run_main(const RunArgs& args) {
-  OpenedInput in = open_input(args.input, args.detector.config);
-  io::RunSettings settings;
-  make_run_options(args.detector, input_platform(in), &settings);
-  const ResolvedOutputs outputs = resolve_outputs(args.outputs, settings);
-  in.source = io::scale_source(std::move(in.source), outputs.scale);
+  pipeline::PreparedRun prepared =
+      pipeline::prepare_run(args.input, args.detector, args.outputs.scale);
+  OpenedInput& in = prepared.input;
+  const ResolvedOutputs outputs = resolve_outputs(args.outputs, prepared.settings);
   const core::Camera& cam = in.source->camera();
-  pipeline::RunOptions options =
-      make_run_options(args.detector, input_platform(in), &settings, &cam);
+  pipeline::RunOptions& options = prepared.options;
   options.keep_maps = !outputs.dump.empty();
-  core::throw_if_invalid(pipeline::validate(options, cam), "invalid parameters");
 
   std::string overlay = args.overlay;
   if (overlay.empty() && args.input.input.empty() && args.input.scenario.empty() &&
