@@ -1,6 +1,12 @@
 #include "live_view.hpp"
 
+#include <netdb.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <opencv2/highgui.hpp>
@@ -21,14 +27,67 @@ bool set(const char* name) {
   return v != nullptr && *v != '\0';
 }
 
+/// True when the X server of `display` ("[host]:N[.screen]") accepts a connection: its local
+/// socket /tmp/.X11-unix/XN (or the abstract one of that name), or TCP port 6000 + N on `host`.
+bool x_server_reachable(const std::string& display) {
+  const auto colon = display.rfind(':');
+  if (colon == std::string::npos) return false;
+  const std::string host = display.substr(0, colon);
+  const std::string number = display.substr(colon + 1, display.find('.', colon) - colon - 1);
+  if (number.empty() || number.find_first_not_of("0123456789") != std::string::npos) return false;
+  auto connects = [](int fd, const sockaddr* address, socklen_t length) {
+    const bool ok = fd >= 0 && connect(fd, address, length) == 0;
+    if (fd >= 0) close(fd);
+    return ok;
+  };
+  if (host.empty() || host == "unix") {
+    const std::string path = "/tmp/.X11-unix/X" + number;
+    for (const bool abstract : {false, true}) {
+      sockaddr_un address{};
+      address.sun_family = AF_UNIX;
+      const size_t offset = abstract ? 1 : 0;  // abstract names start with a NUL byte
+      path.copy(address.sun_path + offset, sizeof address.sun_path - 1 - offset);
+      const auto length =
+          static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + offset + path.size());
+      if (connects(socket(AF_UNIX, SOCK_STREAM, 0), reinterpret_cast<sockaddr*>(&address),
+                   length)) {
+        return true;
+      }
+    }
+    return false;
+  }
+  addrinfo hints{};
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  if (getaddrinfo(host.c_str(), std::to_string(6000 + std::stoi(number)).c_str(), &hints,
+                  &found) != 0) {
+    return false;
+  }
+  bool ok = false;
+  for (addrinfo* a = found; a && !ok; a = a->ai_next)
+    ok = connects(socket(a->ai_family, a->ai_socktype, a->ai_protocol), a->ai_addr, a->ai_addrlen);
+  freeaddrinfo(found);
+  return ok;
+}
+
 }  // namespace
 
 LiveView::LiveView() {
-  if (!set("DISPLAY") && !set("WAYLAND_DISPLAY")) {
-    throw core::InputError("--show needs a display: neither DISPLAY nor WAYLAND_DISPLAY is set");
+  // OpenCV's window toolkit here (Qt, xcb platform) aborts the process when it cannot reach the
+  // X server, so the server is checked first. Under Wayland, XWayland provides DISPLAY.
+  if (!set("DISPLAY")) {
+    throw core::InputError(set("WAYLAND_DISPLAY")
+                               ? "--show needs an X display (XWayland): DISPLAY is not set"
+                               : "--show needs a display: neither DISPLAY nor WAYLAND_DISPLAY "
+                                 "is set");
+  }
+  const std::string display = std::getenv("DISPLAY");
+  if (!x_server_reachable(display)) {
+    throw core::InputError("--show cannot reach the X display " + display);
   }
   try {
-    cv::namedWindow(kWindow, cv::WINDOW_AUTOSIZE);
+    // No toolbar nor status bar (Qt): the window is the picture.
+    cv::namedWindow(kWindow, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);
   } catch (const cv::Exception& e) {
     throw core::InputError("--show cannot open a window: " + e.err);
   }

@@ -20,10 +20,10 @@ namespace sg::test {
 /// Runs `argv` (argv[0] a path, or a name looked up in PATH) in `dir` with stdout and stderr
 /// written to `out` and `err` (empty = /dev/null) and `env` (NAME=value) added to the
 /// environment, "NAME=" removing NAME. SIGINT and SIGTERM take their default action in the child.
-/// Returns its pid.
+/// Descriptors without close-on-exec are inherited. Returns its pid.
 inline pid_t spawn(const std::vector<std::string>& argv, const std::filesystem::path& dir,
                    const std::filesystem::path& out, const std::filesystem::path& err,
-                   const std::vector<std::string>& env = {}, int keep_fd = -1) {
+                   const std::vector<std::string>& env = {}) {
   const pid_t pid = fork();
   if (pid != 0) return pid;
   // Child: only async-signal-safe work would be strictly allowed; the test process is
@@ -48,7 +48,6 @@ inline pid_t spawn(const std::vector<std::string>& argv, const std::filesystem::
       setenv(e.substr(0, eq).c_str(), e.substr(eq + 1).c_str(), 1);
     }
   }
-  (void)keep_fd;  // inherited as it is (not close-on-exec)
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <string>
 #include <vector>
@@ -40,8 +41,9 @@ uint32_t be32(const std::string& s, size_t at) {
   return v;
 }
 
-/// An XWD dump (X11 XWDFileHeader, version 7, ZPixmap, 32 bits per pixel with 8-bit colour
-/// masks, as Xvfb's 24-bit screen gives) as a BGR image; empty when the format is another.
+/// An XWD dump (X11 XWDFileHeader, version 7, ZPixmap, 3 or 4 bytes per pixel with 8-bit colour
+/// masks, as Xvfb's 24-bit screen gives; byte order 0 = LSBFirst) as a BGR image; empty when the
+/// format is another.
 cv::Mat read_xwd(const std::string& data) {
   if (data.size() < 100) return {};
   const uint32_t header_size = be32(data, 0), version = be32(data, 4), format = be32(data, 8);
@@ -49,18 +51,22 @@ cv::Mat read_xwd(const std::string& data) {
   const uint32_t byte_order = be32(data, 28), bits_per_pixel = be32(data, 44);
   const uint32_t bytes_per_line = be32(data, 48), ncolors = be32(data, 76);
   const uint32_t red_mask = be32(data, 56), green_mask = be32(data, 60), blue_mask = be32(data, 64);
-  if (version != 7 || format != 2 || bits_per_pixel != 32) return {};
+  // xwd may call the pixels 24 bits while storing each in 4 bytes: the line length decides.
+  if (version != 7 || format != 2 || width <= 0 || (bits_per_pixel != 24 && bits_per_pixel != 32))
+    return {};
+  const uint32_t bytes_per_pixel = bytes_per_line / static_cast<uint32_t>(width);
+  if (bytes_per_pixel != 3 && bytes_per_pixel != 4) return {};
   if (red_mask != 0xFF0000 || green_mask != 0xFF00 || blue_mask != 0xFF) return {};
   const size_t pixels = header_size + 12u * ncolors;  // XWDColor entries are 12 bytes
   if (data.size() < pixels + static_cast<size_t>(bytes_per_line) * height) return {};
   cv::Mat out(height, width, CV_8UC3);
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
-      const size_t at = pixels + static_cast<size_t>(y) * bytes_per_line + 4u * x;
+      const size_t at = pixels + static_cast<size_t>(y) * bytes_per_line + bytes_per_pixel * x;
       uint32_t v = 0;
-      for (size_t i = 0; i < 4; ++i) {
+      for (size_t i = 0; i < bytes_per_pixel; ++i) {
         const uint32_t byte = static_cast<unsigned char>(data[at + i]);
-        v |= byte_order == 0 ? byte << (8 * i) : byte << (8 * (3 - i));  // 0 = LSBFirst
+        v |= byte_order == 0 ? byte << (8 * i) : byte << (8 * (bytes_per_pixel - 1 - i));
       }
       out.at<cv::Vec3b>(y, x) = cv::Vec3b(v & 0xFF, (v >> 8) & 0xFF, (v >> 16) & 0xFF);
     }
@@ -109,13 +115,22 @@ class CliShow : public ::testing::Test {
         {"DISPLAY=" + display_, "WAYLAND_DISPLAY="});
   }
 
-  /// The screen, read with xwd; empty when it could not be read.
-  cv::Mat screenshot() {
+  /// The screen, read with xwd; empty when it could not be read (`why` says why).
+  cv::Mat screenshot(std::string& why) {
     const pid_t pid = sg::test::spawn({"xwd", "-root", "-silent", "-display", display_}, dir_,
-                                      dir_ / "screen.xwd", "");
+                                      dir_ / "screen.xwd", dir_ / "xwd.txt");
     const std::optional<int> status = sg::test::wait_exit(pid, 60s);
-    if (!status || *status != 0) return {};
-    return read_xwd(sg::test::slurp(dir_ / "screen.xwd"));
+    if (!status || *status != 0) {
+      why = "xwd status " + (status ? std::to_string(*status) : std::string("timeout")) + ": " +
+            sg::test::slurp(dir_ / "xwd.txt");
+      return {};
+    }
+    const std::string data = sg::test::slurp(dir_ / "screen.xwd");
+    why = "unexpected XWD format (" + std::to_string(data.size()) + " bytes; header";
+    for (size_t at = 0; at + 4 <= 100 && at + 4 <= data.size(); at += 4)
+      why += " " + std::to_string(be32(data, at));
+    why += ")";
+    return read_xwd(data);
   }
 
   fs::path dir_;
@@ -123,14 +138,15 @@ class CliShow : public ::testing::Test {
   std::string display_;
 };
 
-/// The bounding box of the pixels that are not black (the -br root).
+/// The bounding box of the pixels unlike the bottom-right one (the root window: without a window
+/// manager the window sits at the top left).
 cv::Rect drawn_area(const cv::Mat& screen) {
-  cv::Mat gray;
   cv::Mat mask(screen.size(), CV_8U);
+  const cv::Vec3b root = screen.at<cv::Vec3b>(screen.rows - 1, screen.cols - 1);
   for (int y = 0; y < screen.rows; ++y)
     for (int x = 0; x < screen.cols; ++x) {
       const cv::Vec3b p = screen.at<cv::Vec3b>(y, x);
-      mask.at<uint8_t>(y, x) = p[0] | p[1] | p[2] ? 255 : 0;
+      mask.at<uint8_t>(y, x) = p == root ? 0 : 255;
     }
   std::vector<cv::Point> points;
   cv::findNonZero(mask, points);
@@ -157,14 +173,17 @@ TEST_F(CliShow, WindowShowsTheOverlayAndSigintEndsTheRunCleanly) {
   const pid_t pid = start_run();
   ASSERT_TRUE(sg::test::wait_lines(dir_ / "events.jsonl", 5, pid, 300s))
       << sg::test::slurp(dir_ / "stderr.txt");
-  // The window maps asynchronously: poll the screen until something is drawn on it.
+  // The window maps and takes its size asynchronously: poll the screen until the drawn area is
+  // the same on two screenshots in a row.
   cv::Mat screen;
-  cv::Rect area;
-  for (int attempt = 0; attempt < 100 && area.area() == 0; ++attempt) {
-    screen = screenshot();
-    ASSERT_FALSE(screen.empty()) << "xwd failed or gave an unexpected format";
+  cv::Rect area, before;
+  for (int attempt = 0; attempt < 100 && (area.area() == 0 || area != before); ++attempt) {
+    before = area;
+    std::this_thread::sleep_for(200ms);
+    std::string why;
+    screen = screenshot(why);
+    ASSERT_FALSE(screen.empty()) << why;
     area = drawn_area(screen);
-    if (area.area() == 0) std::this_thread::sleep_for(200ms);
   }
   ASSERT_GT(area.area(), 0) << "nothing drawn on the screen";
   ASSERT_EQ(kill(pid, SIGINT), 0);
@@ -200,7 +219,7 @@ TEST_F(CliShow, QuitKeyEndsTheRunWithStatusZeroAndInterrupted) {
   std::optional<int> status;
   for (int attempt = 0; attempt < 60 && !status; ++attempt) {
     const pid_t key = sg::test::spawn({"xdotool", "search", "--name", "stereoguard",
-                                       "windowfocus", "--sync", "key", "q"},
+                                       "windowfocus", "key", "q"},
                                       dir_, "", "", {"DISPLAY=" + display_});
     sg::test::wait_exit(key, 60s);
     if (!sg::test::running(pid)) status = sg::test::wait_exit(pid, 10s);

@@ -235,9 +235,9 @@ TEST(Pipeline, EmptyStream) {
 }
 
 /// Counts the frames the emitter takes from a clip.
-class CountingSource : public core::FrameSource {
+class TakenCounter : public core::FrameSource {
  public:
-  explicit CountingSource(const Clip& clip) : memory_(clip.frames, clip.camera) {}
+  explicit TakenCounter(const Clip& clip) : memory_(clip.frames, clip.camera) {}
   std::optional<core::StereoFrame> next() override {
     std::optional<core::StereoFrame> frame = memory_.next();
     if (frame) ++taken_;
@@ -265,7 +265,7 @@ TEST(Pipeline, StopRequestEndsTheRunAfterTheFramesInFlight) {
     o.tokens = c[2];
     std::atomic<bool> stop{false};
     o.stop = &stop;
-    CountingSource source(clip);
+    TakenCounter source(clip);
     std::vector<std::string> lines;
     const RunSummary s = run(source, o, [&](const core::StereoFrame&, const core::Detection& d) {
       lines.push_back(io::detection_to_json(d, /*timing=*/false).dump());
@@ -290,7 +290,7 @@ TEST(Pipeline, StopRequestedBeforeTheStartTakesNoFrame) {
   std::atomic<bool> stop{true};
   RunOptions o = options_for(core::Mode::kStereo);
   o.stop = &stop;
-  CountingSource source(head_on());
+  TakenCounter source(head_on());
   int calls = 0;
   const RunSummary s = run(source, o, [&](const auto&, const auto&) { ++calls; });
   EXPECT_TRUE(s.interrupted);
