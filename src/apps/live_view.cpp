@@ -86,8 +86,9 @@ LiveView::LiveView() {
     throw core::InputError("--show cannot reach the X display " + display);
   }
   try {
-    // No toolbar nor status bar (Qt): the window is the picture.
-    cv::namedWindow(kWindow, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);
+    // No toolbar nor status bar (Qt): the window is the picture, sized to it on the first frame;
+    // the user may resize it, the picture keeps its aspect ratio.
+    cv::namedWindow(kWindow, cv::WINDOW_NORMAL | cv::WINDOW_KEEPRATIO | cv::WINDOW_GUI_NORMAL);
   } catch (const cv::Exception& e) {
     throw core::InputError("--show cannot open a window: " + e.err);
   }
@@ -130,6 +131,7 @@ bool LiveView::show(const cv::Mat& overlay, const core::Detection& detection) {
                 cv::FILLED);
   cv::putText(shown, text, cv::Point(pad, shown.rows - baseline - pad), kFont, scale,
               cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  if (first) cv::resizeWindow(kWindow, shown.size());
   cv::imshow(kWindow, shown);
   const int key = cv::waitKey(1);
   if (key >= 0 && ((key & 0xFF) == 'q' || (key & 0xFF) == 'Q' || (key & 0xFF) == 27)) return false;
