@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
       app.parse(argc, argv);
     }
     if (app.get_subcommands().empty()) throw CLI::CallForHelp();
+  } catch (const sg::apps::ExitStatus& e) {
+    return e.status;
   } catch (const CLI::Success& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {

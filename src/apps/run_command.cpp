@@ -1,5 +1,6 @@
-// `stereoguard run`: the main job. Detects obstacles on a scenario or a stereo folder, writes
-// events, an overlay video and a summary.
+// `stereoguard run`: the main job. Detects obstacles on any input (scenario, stereo folder,
+// videos, KITTI, EuRoC, camera), writes events, an overlay video and a summary, shows the overlay
+// live (--show), and stops cleanly on SIGINT, SIGTERM or the live view's q (docs/live-and-stop.md).
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -10,7 +11,9 @@
 
 #include "commands.hpp"
 #include "options.hpp"
+#include "live_view.hpp"
 #include "outputs.hpp"
+#include "stop_signals.hpp"
 #include "sg/core/error.hpp"
 #include "sg/io/events.hpp"
 #include "sg/io/overlay.hpp"
@@ -26,6 +29,7 @@ struct RunArgs {
   std::string events, overlay, summary;
   bool no_timing = false;
   bool quiet = false;
+  bool show = false;
 };
 
 /// One line when the warning state changes, so a user sees the warnings as they happen.
@@ -66,6 +70,7 @@ class WarningPrinter {
 };
 
 void run_main(const RunArgs& args) {
+  StopOnSignals stop;
   pipeline::PreparedRun prepared =
       pipeline::prepare_run(args.input, args.detector, args.outputs.scale);
   OpenedInput& in = prepared.input;
@@ -73,6 +78,10 @@ void run_main(const RunArgs& args) {
   const core::Camera& cam = in.source->camera();
   pipeline::RunOptions& options = prepared.options;
   options.keep_maps = !outputs.dump.empty();
+  options.stop = &stop.flag();
+  // Before any output exists: without a display, --show is a user error like a bad path.
+  std::optional<LiveView> view;
+  if (args.show) view.emplace();
 
   std::string overlay = args.overlay;
   if (overlay.empty() && args.input.input.empty() && args.input.scenario.empty() &&
@@ -103,7 +112,11 @@ void run_main(const RunArgs& args) {
     summary = pipeline::run(*in.source, options,
                             [&](const core::StereoFrame& frame, const core::Detection& d) {
                               if (events) events->write(d);
-                              if (video) video->write(frame, d);
+                              if (video || view) {
+                                const cv::Mat drawn = io::draw_overlay(frame, d);
+                                if (video) video->write(drawn);
+                                if (view && !view->show(drawn, d)) stop.request();
+                              }
                               frame_outputs.write(d);
                               if (args.quiet) return;
                               warning.str("");
@@ -136,6 +149,7 @@ void run_main(const RunArgs& args) {
     out << summary.to_json().dump(2) << "\n";
     std::cout << "summary           " << args.summary << "\n";
   }
+  if (stop.exit_status() != 0) throw ExitStatus{stop.exit_status()};
 }
 
 }  // namespace
@@ -143,7 +157,9 @@ void run_main(const RunArgs& args) {
 void add_run_command(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "run", "detect obstacles on a scenario or a stereo folder (default: the head-on scenario)");
+      "run",
+      "detect obstacles on any input: scenario, stereo folder, videos, KITTI, EuRoC or camera "
+      "(default: the head-on scenario)");
   add_input_options(*cmd, args->input);
   add_detector_options(*cmd, args->detector);
   cmd->add_option("--events", args->events, "write one JSON line per frame to this file");
@@ -156,6 +172,9 @@ void add_run_command(CLI::App& app) {
   cmd->add_flag("--quiet", args->quiet,
                 "do not print warnings as they happen, nor the progress bar (shown only when "
                 "stderr is a terminal)");
+  cmd->add_flag("--show", args->show,
+                "show the overlay live in a window (needs a display); q or Esc stops the run "
+                "like Ctrl-C, with exit status 0");
   cmd->callback([args] { run_main(*args); });
 }
 

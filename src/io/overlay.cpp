@@ -157,10 +157,14 @@ OverlayWriter::OverlayWriter(const std::filesystem::path& path, cv::Size size, d
 }
 
 void OverlayWriter::write(const core::StereoFrame& frame, const core::Detection& detection) {
+  write(draw_overlay(frame, detection));
+}
+
+void OverlayWriter::write(const cv::Mat& overlay) {
   if (!writer_.isOpened()) {
     throw core::InputError("overlay video already closed: " + path_.string());
   }
-  cv::Mat image = draw_overlay(frame, detection);
+  cv::Mat image = overlay;
   if (image.size() != size_) cv::resize(image, image, size_, 0, 0, cv::INTER_AREA);
   writer_.write(image);
   ++frames_;

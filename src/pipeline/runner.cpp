@@ -78,9 +78,14 @@ struct FrameJob {
 /// time, so its latency includes any wait for a token.
 class Emitter {
  public:
-  Emitter(core::FrameSource& source, double pace_fps) : source_(source), pace_fps_(pace_fps) {}
+  Emitter(core::FrameSource& source, double pace_fps, const std::atomic<bool>* stop)
+      : source_(source), pace_fps_(pace_fps), stop_(stop) {}
 
   std::optional<FrameJob> operator()() {
+    if (stop_ && stop_->load(std::memory_order_relaxed)) {
+      stopped_ = true;
+      return std::nullopt;
+    }
     const par::TimePoint begin = par::now();
     const int lost_before = dropped();
     std::optional<core::PendingFrame> frame = read();
@@ -122,6 +127,8 @@ class Emitter {
   /// that the pipeline keeps up). Read from the farm's threads (FarmConfig::admit_just_in_time).
   bool falling_behind() const { return behind_.load(std::memory_order_relaxed); }
   double busy_ms() const { return busy_ms_; }
+  /// True when the stream ended on the stop request rather than at the source's end.
+  bool stopped() const { return stopped_; }
   void start(par::TimePoint t0) { t0_ = t0; }
 
  private:
@@ -142,6 +149,8 @@ class Emitter {
 
   core::FrameSource& source_;
   double pace_fps_;
+  const std::atomic<bool>* stop_;
+  bool stopped_ = false;
   par::TimePoint t0_;
   std::shared_ptr<LazyFrame> previous_;
   par::TimePoint acquired_;
@@ -324,7 +333,7 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   if (options.prefault_heap) {
     par::prefault_heap(heap_estimate(options, source.camera().width, source.camera().height));
   }
-  Emitter emitter(source, options.pace_fps);
+  Emitter emitter(source, options.pace_fps, options.stop);
   // A camera that outpaces the pipeline: the next frame is taken when it can start at once, so it
   // is the freshest (its latency counts from its capture), not as soon as a token frees, when it
   // would wait behind the older frames' stereo and flow. At 150 % of capacity: a median latency
@@ -396,6 +405,7 @@ RunSummary run(core::FrameSource& source, const RunOptions& options, const Detec
   }
 
   s.dropped = emitter.dropped();
+  s.interrupted = emitter.stopped();
   s.busy_emitter_ms = emitter.busy_ms();
   s.wall_s = std::chrono::duration<double>(last_done - start).count();
   s.throughput_fps = s.wall_s > 0 ? s.frames / s.wall_s : 0.0;
@@ -415,6 +425,7 @@ nlohmann::json RunSummary::to_json() const {
           {"alarm_frames", alarm_frames},
           {"first_alarm_frame", opt(first_alarm_frame)},
           {"first_alarm_time_s", opt(first_alarm_time_s)},
+          {"interrupted", interrupted},
           {"deadline_misses", deadline_misses},
           {"wall_s", wall_s},
           {"throughput_fps", throughput_fps},
@@ -452,6 +463,7 @@ std::string RunSummary::text() const {
   s << "frames processed  " << frames;
   if (pace_fps > 0) s << " (dropped " << dropped << ", deadline misses " << deadline_misses << ")";
   s << "\n";
+  if (interrupted) s << "interrupted       yes: stopped taking frames on request\n";
   s << "alarm frames      " << alarm_frames << "\n";
   s << "first alarm       ";
   if (first_alarm_frame) {

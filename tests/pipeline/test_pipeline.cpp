@@ -234,6 +234,81 @@ TEST(Pipeline, EmptyStream) {
   EXPECT_EQ(s.frames, 0);
 }
 
+/// Counts the frames the emitter takes from a clip.
+class TakenCounter : public core::FrameSource {
+ public:
+  explicit TakenCounter(const Clip& clip) : memory_(clip.frames, clip.camera) {}
+  std::optional<core::StereoFrame> next() override {
+    std::optional<core::StereoFrame> frame = memory_.next();
+    if (frame) ++taken_;
+    return frame;
+  }
+  const core::Camera& camera() const override { return memory_.camera(); }
+  int taken() const { return taken_; }
+
+ private:
+  io::MemorySource memory_;
+  int taken_ = 0;
+};
+
+TEST(Pipeline, StopRequestEndsTheRunAfterTheFramesInFlight) {
+  const Clip& clip = head_on();
+  const RunOptions reference = options_for(core::Mode::kStereoFlow);
+  const std::vector<std::string> full = detections(clip, reference);
+  constexpr int kStopAfter = 5;
+  // (W, T, tokens): sequential, a farm with its automatic tokens, a farm with many in flight.
+  const int configs[][3] = {{1, 1, 0}, {2, 2, 0}, {3, 1, 8}};
+  for (const auto& c : configs) {
+    RunOptions o = reference;
+    o.workers = c[0];
+    o.tiles = c[1];
+    o.tokens = c[2];
+    std::atomic<bool> stop{false};
+    o.stop = &stop;
+    TakenCounter source(clip);
+    std::vector<std::string> lines;
+    const RunSummary s = run(source, o, [&](const core::StereoFrame&, const core::Detection& d) {
+      lines.push_back(io::detection_to_json(d, /*timing=*/false).dump());
+      if (static_cast<int>(lines.size()) == kStopAfter) stop = true;
+    });
+    const std::string config = "W " + std::to_string(c[0]) + " T " + std::to_string(c[1]) +
+                               " tokens " + std::to_string(c[2]);
+    EXPECT_TRUE(s.interrupted) << config;
+    // Every frame taken is finished and delivered; no more than the tokens follow the request.
+    EXPECT_EQ(source.taken(), static_cast<int>(lines.size())) << config;
+    EXPECT_EQ(s.frames, static_cast<int>(lines.size())) << config;
+    EXPECT_GE(s.frames, kStopAfter) << config;
+    EXPECT_LE(s.frames, kStopAfter + effective_tokens(o)) << config;
+    // In order and complete: the first frames of the uninterrupted run, detection for detection.
+    ASSERT_LE(lines.size(), full.size());
+    EXPECT_EQ(lines, std::vector<std::string>(full.begin(), full.begin() + lines.size()))
+        << config;
+  }
+}
+
+TEST(Pipeline, StopRequestedBeforeTheStartTakesNoFrame) {
+  std::atomic<bool> stop{true};
+  RunOptions o = options_for(core::Mode::kStereo);
+  o.stop = &stop;
+  TakenCounter source(head_on());
+  int calls = 0;
+  const RunSummary s = run(source, o, [&](const auto&, const auto&) { ++calls; });
+  EXPECT_TRUE(s.interrupted);
+  EXPECT_EQ(s.frames, 0);
+  EXPECT_EQ(calls, 0);
+  EXPECT_EQ(source.taken(), 0);
+}
+
+TEST(Pipeline, RunToTheEndIsNotInterrupted) {
+  std::atomic<bool> stop{false};
+  RunOptions o = options_for(core::Mode::kStereo);
+  o.stop = &stop;
+  RunSummary s;
+  EXPECT_EQ(detections(head_on(), o, &s).size(), head_on().frames.size());
+  EXPECT_FALSE(s.interrupted);
+  EXPECT_FALSE(s.to_json().at("interrupted").get<bool>());
+}
+
 /// Delivers `good` frames of a clip, then throws.
 class FailingSource : public core::FrameSource {
  public:

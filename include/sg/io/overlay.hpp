@@ -22,8 +22,11 @@ class OverlayWriter {
   OverlayWriter(const std::filesystem::path& path, cv::Size size, double fps);
   /// Draws and appends one overlay frame; throws core::InputError after close().
   void write(const core::StereoFrame& frame, const core::Detection& detection);
+  /// Appends an overlay already drawn by draw_overlay (CV_8UC3); throws core::InputError after
+  /// close().
+  void write(const cv::Mat& overlay);
   int frames_written() const { return frames_; }
-  /// Finalises the file (also done by the destructor).
+  /// Finalises the file so that it plays (also done by the destructor).
   void close();
 
  private:

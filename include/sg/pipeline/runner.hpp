@@ -4,6 +4,7 @@
 /// a relay (in order: the detector's history), the labelling as farm tasks in row bands, the
 /// collector (restore order, obstacles, signals), and its metrics. This layer wires the vision
 /// kernels onto the par skeletons; it is the only place where both meet.
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -44,6 +45,11 @@ struct RunOptions {
   /// freed memory stays on the heap; `stereoguard run` and `eval` set it (with glibc tuned in
   /// main). Off by default.
   bool prefault_heap = false;
+  /// A stop request, e.g. set from a signal handler or a user interface; null = none. Once it
+  /// reads true, the emitter takes no more frames from the source; the frames in flight finish
+  /// and are delivered to the sink in order, and run() returns normally with
+  /// RunSummary::interrupted set. Checked before each frame is read; must outlive run().
+  const std::atomic<bool>* stop = nullptr;
 };
 
 /// The W and T that `--workers auto` and `--tiles auto` (the CLI's defaults) pick for a task
@@ -78,6 +84,9 @@ struct RunSummary {
   int alarm_frames = 0;
   std::optional<int> first_alarm_frame;
   std::optional<double> first_alarm_time_s;
+  /// True when the run ended on RunOptions::stop before the source ended: `frames` counts the
+  /// frames processed up to then.
+  bool interrupted = false;
   int deadline_misses = 0;      ///< latency > 1 / pace_fps (paced runs only)
   double wall_s = 0.0;          ///< first frame read to last detection, s
   double throughput_fps = 0.0;  ///< frames / wall_s
