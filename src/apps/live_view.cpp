@@ -103,7 +103,7 @@ LiveView::~LiveView() {
   }
 }
 
-bool LiveView::show(const cv::Mat& overlay, const core::Detection& detection) {
+bool LiveView::show(const cv::Mat& overlay, double latency_ms) {
   const auto now = std::chrono::steady_clock::now();
   if (last_shown_) {
     const double ms = std::chrono::duration<double, std::milli>(now - *last_shown_).count();
@@ -116,9 +116,9 @@ bool LiveView::show(const cv::Mat& overlay, const core::Detection& detection) {
   char text[64];
   if (interval_ms_ > 0) {
     std::snprintf(text, sizeof text, "%.1f fps  latency %.0f ms", 1000.0 / interval_ms_,
-                  detection.latency_ms);
+                  latency_ms);
   } else {
-    std::snprintf(text, sizeof text, "latency %.0f ms", detection.latency_ms);
+    std::snprintf(text, sizeof text, "latency %.0f ms", latency_ms);
   }
   constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
   const double scale = std::max(0.4, shown.cols / 1280.0);
@@ -133,10 +133,15 @@ bool LiveView::show(const cv::Mat& overlay, const core::Detection& detection) {
               cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   if (first) cv::resizeWindow(kWindow, shown.size());
   cv::imshow(kWindow, shown);
-  const int key = cv::waitKey(1);
+  ++frames_shown_;
+  return poll(1);
+}
+
+bool LiveView::poll(int wait_ms) {
+  const int key = cv::waitKey(wait_ms);
   if (key >= 0 && ((key & 0xFF) == 'q' || (key & 0xFF) == 'Q' || (key & 0xFF) == 27)) return false;
   // The window closed by its title bar: shown no more.
-  if (!first && cv::getWindowProperty(kWindow, cv::WND_PROP_VISIBLE) < 1) return false;
+  if (frames_shown_ > 1 && cv::getWindowProperty(kWindow, cv::WND_PROP_VISIBLE) < 1) return false;
   return true;
 }
 

@@ -5,7 +5,6 @@
 #include <optional>
 #include <opencv2/core.hpp>
 
-#include "sg/core/detection.hpp"
 
 namespace sg::apps {
 
@@ -20,12 +19,16 @@ class LiveView {
   LiveView& operator=(const LiveView&) = delete;
 
   /// Shows `overlay` (CV_8UC3, as drawn by io::draw_overlay; not modified) with the display rate
-  /// and `detection.latency_ms`, and handles the window's events. Returns false when the user
-  /// asked to stop: q or Esc pressed, or the window closed.
-  bool show(const cv::Mat& overlay, const core::Detection& detection);
+  /// and the frame's `latency_ms`, and handles the window's events. Returns false when the user
+  /// asked to stop: q or Esc pressed, or the window closed. Call it, poll and the constructor and
+  /// destructor on one thread (the window toolkit's: run_command keeps it on the main thread).
+  bool show(const cv::Mat& overlay, double latency_ms);
+  /// Handles the window's events for up to `wait_ms` without a new frame; false as show's.
+  bool poll(int wait_ms);
 
  private:
   std::optional<std::chrono::steady_clock::time_point> last_shown_;
+  int frames_shown_ = 0;
   double interval_ms_ = 0.0;  ///< smoothed time between two frames shown, ms (0 before two)
 };
 

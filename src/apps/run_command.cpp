@@ -8,6 +8,7 @@
 #include <iostream>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 #include "commands.hpp"
 #include "options.hpp"
@@ -17,6 +18,7 @@
 #include "sg/core/error.hpp"
 #include "sg/io/events.hpp"
 #include "sg/io/overlay.hpp"
+#include "sg/par/beside.hpp"
 
 namespace sg::apps {
 namespace {
@@ -108,24 +110,42 @@ void run_main(const RunArgs& args) {
   WarningPrinter printer;
   std::ostringstream warning;
   pipeline::RunSummary summary;
+  // Frames for the window, which lives on this thread: the newest one waits here for it.
+  par::Latest<std::pair<cv::Mat, double>> for_view;
+  const pipeline::DetectionSink sink = [&](const core::StereoFrame& frame,
+                                           const core::Detection& d) {
+    if (events) events->write(d);
+    if (video || view) {
+      const cv::Mat drawn = io::draw_overlay(frame, d);
+      if (video) video->write(drawn);
+      if (view) for_view.put({drawn, d.latency_ms});
+    }
+    frame_outputs.write(d);
+    if (args.quiet) return;
+    warning.str("");
+    printer(d, warning);
+    if (warning.tellp() > 0) {
+      frame_outputs.clear_progress();
+      std::cout << warning.str() << std::flush;
+    }
+  };
   try {
-    summary = pipeline::run(*in.source, options,
-                            [&](const core::StereoFrame& frame, const core::Detection& d) {
-                              if (events) events->write(d);
-                              if (video || view) {
-                                const cv::Mat drawn = io::draw_overlay(frame, d);
-                                if (video) video->write(drawn);
-                                if (view && !view->show(drawn, d)) stop.request();
-                              }
-                              frame_outputs.write(d);
-                              if (args.quiet) return;
-                              warning.str("");
-                              printer(d, warning);
-                              if (warning.tellp() > 0) {
-                                frame_outputs.clear_progress();
-                                std::cout << warning.str() << std::flush;
-                              }
-                            });
+    if (!view) {
+      summary = pipeline::run(*in.source, options, sink);
+    } else {
+      // The pipeline beside, the window here: q, Esc or closing it stops the run.
+      par::run_beside([&] { summary = pipeline::run(*in.source, options, sink); },
+                      [&] {
+                        try {
+                          const auto next = for_view.take();
+                          if (!(next ? view->show(next->first, next->second) : view->poll(5)))
+                            stop.request();
+                        } catch (...) {
+                          stop.request();
+                          throw;
+                        }
+                      });
+    }
   } catch (...) {
     if (video) {
       video->close();

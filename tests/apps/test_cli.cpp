@@ -111,15 +111,25 @@ TEST_F(Cli, LeftRightSizesDiffer) {
   expect_user_error(run("run --input '" + folder.string() + "'"), "000000.png");
 }
 
+// The sequential run (one worker, one tile) delivers every frame before the broken one; a
+// parallel one stops at the error too, and what it delivered is a prefix of those frames (a frame
+// still in flight is lost), each line a complete JSON object.
 TEST_F(Cli, CorruptPngMidSequenceKeepsEventsValid) {
   const fs::path folder = small_folder(6);
   std::ofstream(folder / "left" / "000004.png", std::ios::binary) << "not a png at all";
   const fs::path events = dir_ / "events.jsonl";
-  const Result r = run("run --input '" + folder.string() + "' --events '" + events.string() + "'");
-  expect_user_error(r, "000004.png");
-  const auto lines = read_events(events);
-  ASSERT_EQ(lines.size(), 4u);  // frames 0..3, each a complete JSON object
-  for (size_t i = 0; i < lines.size(); ++i) EXPECT_EQ(lines[i]["frame"], i);
+  for (const char* workers : {"1 --tiles 1", "auto"}) {
+    const Result r = run("run --workers " + std::string(workers) + " --input '" +
+                         folder.string() + "' --events '" + events.string() + "'");
+    expect_user_error(r, "000004.png");
+    const auto lines = read_events(events);
+    if (std::string(workers) != "auto") {
+      ASSERT_EQ(lines.size(), 4u);  // frames 0..3
+    } else {
+      ASSERT_LE(lines.size(), 4u);
+    }
+    for (size_t i = 0; i < lines.size(); ++i) EXPECT_EQ(lines[i]["frame"], i) << workers;
+  }
 }
 
 TEST_F(Cli, FailedRunLeavesNoOverlay) {
@@ -455,7 +465,7 @@ TEST_F(Cli, CorruptPngWithParallelPipelineIsStillACleanError) {
 
 TEST_F(Cli, InvalidParallelOptions) {
   expect_user_error(run("run --scenario '" + small_scenario().string() + "' --workers 0"),
-                    "workers=0");
+                    "--workers must be a positive integer or auto");
   expect_user_error(run("run --scenario '" + small_scenario().string() + "' --tiles 100"),
                     "tiles=100");
 }
@@ -656,7 +666,9 @@ TEST_F(Cli, CsvHasAHeaderAndOneRowPerFrameAgreeingWithTheEvents) {
 TEST_F(Cli, CsvOfAFailedRunKeepsItsCompleteRows) {
   const fs::path folder = small_folder(6);
   std::ofstream(folder / "left" / "000004.png", std::ios::binary) << "not a png at all";
-  const Result r = run("run --quiet --input '" + folder.string() + "' --csv m.csv");
+  // Sequential: every frame before the broken one (a parallel run may stop a frame sooner).
+  const Result r =
+      run("run --quiet --workers 1 --tiles 1 --input '" + folder.string() + "' --csv m.csv");
   expect_user_error(r, "000004.png");
   const auto rows = read_csv(dir_ / "m.csv");
   ASSERT_EQ(rows.size(), 5u);  // header + frames 0..3
