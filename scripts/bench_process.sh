@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # Whole-process benchmark on a stereo folder (docs/performance.md): the plain loop a user would
 # write (build/release/plain_loop: imread, StereoBM, DIS ultrafast, a one-gap labelling, OpenCV's
-# default threads) against `stereoguard run --input DIR --workers 2`, in both modes, and with
-# `--matcher fast`. Every command runs as its own process, RUNS rounds, the commands in a rotated
-# order each round so that a change in machine load hits all of them alike. Prints each
-# command's median wall and CPU time and, per mode, the median over rounds of the ratio
-# plain-loop wall / run wall (the speedup; pairs from the same round).
+# default threads) against `stereoguard run --input DIR` with its default W and T (auto), in
+# both modes, and with `--matcher fast`. Every command runs as its own process, RUNS rounds, the
+# commands in a rotated order each round so that a change in machine load hits all of them alike.
+# Prints each command's median wall and CPU time and, per mode, the median over rounds of the
+# ratio plain-loop wall / run wall (the speedup; pairs from the same round).
 #
 #   scripts/bench_process.sh DIR [RUNS]       (RUNS default 7)
-#   BUILD=build/release WORKERS=2 MODES="stereo stereo-flow" MATCHERS="bm fast" PLAIN_LABELLING=naive
+#   BUILD=build/release WORKERS=auto MODES="stereo stereo-flow" MATCHERS="bm fast" PLAIN_LABELLING=naive
 #   PLAIN_TUNED=1: run the plain loop with the malloc settings stereoguard sets for itself
 #   (freed maps stay on the heap, see src/apps/main.cpp), to separate that gain from the pipeline's
 #
@@ -19,7 +19,7 @@ here="$(cd "$(dirname "$0")/.." && pwd)"
 build="${BUILD:-$here/build/release}"
 sg="$build/stereoguard"
 plain="$build/plain_loop"
-workers="${WORKERS:-2}"
+workers="${WORKERS:-auto}"  # auto: run's default
 modes="${MODES:-stereo stereo-flow}"
 matchers="${MATCHERS:-bm fast}"
 plain_labelling="${PLAIN_LABELLING:-naive}"

@@ -2,8 +2,8 @@
 # Installs what is missing, builds, and runs every test (unit, slow, data; data tests skip when
 # ../shared is absent), then the skeleton and pipeline tests again under ThreadSanitizer, then the
 # whole suite under AddressSanitizer + UndefinedBehaviorSanitizer (LeakSanitizer reports fail).
-# The soak (label soak) and the fuzz targets (preset fuzz) are not part of it: see README
-# "Sanitizers, fuzzing, soak".
+# The soak (label soak) and the fuzz targets (preset fuzz) are not part of it; the ASan stage
+# leaves out the live-window tests (label gui, docs/live-and-stop.md): see docs/reliability.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs="$(nproc)"

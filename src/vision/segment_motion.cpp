@@ -255,6 +255,34 @@ float interquartile_mean(float* v, size_t n) {
   return static_cast<float>(sum / static_cast<double>(high - low));
 }
 
+namespace {
+
+/// Weighted selection on a[lo, hi) (value, weight) pairs whose preceding elements weigh `base`:
+/// partitions it (std::nth_element steps, expected O(hi - lo)) until the element k covering
+/// weight position `pos` (base + weight of [lo, k) <= pos < that + its own weight) has only
+/// values <= its own before it and >= after it. Returns k; `base` becomes the weight before k.
+size_t weighted_select(std::pair<float, int>* a, size_t lo, size_t hi, long long& base,
+                       long long pos) {
+  while (hi - lo > 1) {
+    const size_t mid = lo + (hi - lo) / 2;
+    std::nth_element(a + lo, a + mid, a + hi);
+    long long left = 0;
+    for (size_t i = lo; i < mid; ++i) left += a[i].second;
+    if (pos < base + left) {
+      hi = mid;
+    } else if (pos < base + left + a[mid].second) {
+      base += left;
+      return mid;
+    } else {
+      base += left + a[mid].second;
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
+}  // namespace
+
 float weighted_interquartile_mean(const float* v, const int* w, size_t n,
                                   std::vector<std::pair<float, int>>& scratch, float* low,
                                   float* high) {
@@ -264,23 +292,27 @@ float weighted_interquartile_mean(const float* v, const int* w, size_t n,
     scratch[i] = {v[i], w[i]};
     total += w[i];
   }
-  std::sort(scratch.begin(), scratch.end());
-  // The copies of the sorted values occupy positions [0, total): keep [trim, total - trim).
+  // The copies of the sorted values occupy positions [0, total): keep [trim, end). Two weighted
+  // selections find the values on the borders; what lies between them is the middle, in some
+  // order (a sort of a near surface's thousands of samples cost 1 ms a frame).
   const long long trim = total / 4, end = total - trim;
-  double sum = 0.0;
-  long long kept = 0, at = 0;
-  for (const auto& [value, weight] : scratch) {
-    const long long from = std::max(at, trim), to = std::min(at + weight, end);
-    at += weight;
-    if (to > from) {
-      if (kept == 0 && low) *low = value;
-      if (high) *high = value;
-      sum += static_cast<double>(value) * static_cast<double>(to - from);
-      kept += to - from;
-    }
-    if (at >= end) break;
+  std::pair<float, int>* a = scratch.data();
+  long long before_first = 0;
+  const size_t first = weighted_select(a, 0, n, before_first, trim);
+  const long long first_to = std::min(before_first + a[first].second, end);
+  if (low) *low = a[first].first;
+  if (first_to >= end) {  // both borders in one value
+    if (high) *high = a[first].first;
+    return a[first].first;
   }
-  return static_cast<float>(sum / static_cast<double>(kept));
+  long long before_last = before_first + a[first].second;
+  const size_t last = weighted_select(a, first + 1, n, before_last, end - 1);
+  if (high) *high = a[last].first;
+  double sum = static_cast<double>(a[first].first) * static_cast<double>(first_to - trim);
+  for (size_t i = first + 1; i < last; ++i)
+    sum += static_cast<double>(a[i].first) * static_cast<double>(a[i].second);
+  sum += static_cast<double>(a[last].first) * static_cast<double>(end - before_last);
+  return static_cast<float>(sum / static_cast<double>(end - trim));
 }
 
 double slope_doubt(const std::vector<double>& times_s, const std::vector<double>& residuals,

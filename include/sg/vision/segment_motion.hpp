@@ -35,7 +35,7 @@ float interquartile_mean(float* v, size_t n);
 /// floor(W / 4) of the total weight W is trimmed from each end of the sorted values, a value on
 /// a border keeping the weight left of it. Equal to interquartile_mean of the values repeated
 /// w[i] times (up to a float rounding). low and high (optional): the smallest and the largest
-/// value kept. Sorts (value, weight) pairs in `scratch`.
+/// value kept. Reorders (value, weight) pairs in `scratch`: two weighted selections, O(n).
 float weighted_interquartile_mean(const float* v, const int* w, size_t n,
                                   std::vector<std::pair<float, int>>& scratch,
                                   float* low = nullptr, float* high = nullptr);
