@@ -15,9 +15,9 @@ core::Detection SequentialDetector::process(const core::StereoFrame& frame) {
   vision::check_frame(frame);
   if (frame.left.cols != camera_.width || frame.left.rows != camera_.height) {
     throw core::InputError("frame " + std::to_string(frame.index) + " is " +
-                           std::to_string(frame.left.cols) + "x" +
-                           std::to_string(frame.left.rows) + ", the camera " +
-                           std::to_string(camera_.width) + "x" + std::to_string(camera_.height));
+                           std::to_string(frame.left.cols) + "x" + std::to_string(frame.left.rows) +
+                           ", the camera " + std::to_string(camera_.width) + "x" +
+                           std::to_string(camera_.height));
   }
   const core::Needs need = core::needs(params_.mode);
   vision::FrameMaps maps;

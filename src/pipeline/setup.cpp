@@ -78,9 +78,8 @@ core::CameraFit camera_fit(const RunOptions& options, const core::Camera& camera
   return fit;
 }
 
-RunOptions make_run_options(const DetectorOptions& o,
-                                      const std::string& default_platform,
-                                      io::RunSettings* settings_out, const core::Camera* camera) {
+RunOptions make_run_options(const DetectorOptions& o, const std::string& default_platform,
+                            io::RunSettings* settings_out, const core::Camera* camera) {
   RunOptions run;
   io::RunSettings settings;
   std::string platform = default_platform;

@@ -30,10 +30,10 @@ struct InputOptions {
 
 /// An opened input: the source, plus the simulator or folder behind it (for ground truth).
 struct OpenedInput {
-  std::string name;                          ///< scenario name or folder path
+  std::string name;  ///< scenario name or folder path
   std::unique_ptr<core::FrameSource> source;
-  sim::ScenarioSource* scenario = nullptr;   ///< when the input is a scenario
-  io::FolderSource* folder = nullptr;        ///< when the input is a stereo folder
+  sim::ScenarioSource* scenario = nullptr;  ///< when the input is a scenario
+  io::FolderSource* folder = nullptr;       ///< when the input is a stereo folder
 };
 
 /// Opens the input; `config` (a config file, may be empty) supplies its `input:` section when
