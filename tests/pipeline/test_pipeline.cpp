@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <stdexcept>
 
@@ -26,7 +27,19 @@ const bool kOpenCvSerial = [] {
   cv::setNumThreads(0);
   return true;
 }();
+// Under TSan a run is 20-40x slower: the configuration tests keep the ones that put each part of
+// the skeleton under concurrent use (the farm, tiles, both, the tightest token bound, more workers
+// than cores); the release stage runs every configuration listed.
+constexpr bool kSanitizedThreads = true;
+#else
+constexpr bool kSanitizedThreads = false;
 #endif
+
+/// The configurations to run: all of them, or under TSan the first `tsan_count`.
+template <typename T, size_t N>
+std::vector<T> configurations(const T (&all)[N], size_t tsan_count) {
+  return {all, all + (kSanitizedThreads ? std::min(tsan_count, N) : N)};
+}
 
 /// A built-in scenario at 321x241 (odd size, f = 250 px), started nearer so that 36 frames hold
 /// an approach, rendered once.
@@ -88,11 +101,13 @@ TEST_P(EveryConfiguration, GivesTheSequentialDetections) {
     const RunOptions reference = options_for(GetParam());
     const std::vector<std::string> expected = detections(*clip, reference);
     ASSERT_EQ(expected.size(), clip->frames.size());
-    // (arena threads, W, T, tokens): the farm alone, tiles alone, both, the tightest token
-    // bound, more workers than cores, and a one-thread arena that must still get through.
-    const int configs[][4] = {{1, 2, 1, 0}, {1, 1, 3, 0}, {2, 2, 1, 0}, {2, 1, 2, 0},
-                              {2, 2, 5, 0}, {2, 3, 2, 1}, {2, 3, 1, 6}, {0, 2, 2, 0}};
-    for (const auto& c : configs) {
+    // (arena threads, W, T, tokens): the farm alone, tiles alone, both with more workers than
+    // cores and the tightest token bound, a one-thread arena that must still get through (TSan
+    // runs these four); then one-thread farm, many tiles, many tokens and the default arena.
+    using Config = std::array<int, 4>;
+    const Config all[] = {{2, 2, 1, 0}, {2, 1, 2, 0}, {2, 3, 2, 1}, {1, 1, 3, 0},
+                          {1, 2, 1, 0}, {2, 2, 5, 0}, {2, 3, 1, 6}, {0, 2, 2, 0}};
+    for (const Config& c : configurations(all, 4)) {
       RunOptions o = reference;
       o.threads = c[0];
       o.workers = c[1];
@@ -121,7 +136,8 @@ TEST(Pipeline, LongSeqMatcherTilesAndWorkersGiveTheSequentialDetections) {
       return l.find("\"signal\":true") != std::string::npos;
     });
     EXPECT_GT(fired, 0) << core::to_string(mode);  // the box comes at the camera
-    for (const auto& [w, t] : {std::pair{2, 1}, std::pair{1, 3}, std::pair{2, 2}}) {
+    const std::pair<int, int> all[] = {{2, 2}, {2, 1}, {1, 3}};  // TSan: both at once only
+    for (const auto& [w, t] : configurations(all, 1)) {
       RunOptions o = reference;
       o.workers = w;
       o.tiles = t;
@@ -146,8 +162,8 @@ TEST_P(SurveyedDetector, FiresOnTheApproachAndEveryConfigurationGivesTheSequenti
   const core::Needs need = core::needs(GetParam());
   EXPECT_EQ(s.busy_sm_ms > 0, need.disparity);
   EXPECT_EQ(s.busy_of_ms > 0, need.flow);
-  for (const auto& [w, t, tokens] : {std::tuple{2, 1, 0}, std::tuple{1, 3, 0},
-                                     std::tuple{2, 2, 0}, std::tuple{3, 2, 1}}) {
+  const std::tuple<int, int, int> all[] = {{3, 2, 1}, {2, 2, 0}, {2, 1, 0}, {1, 3, 0}};
+  for (const auto& [w, t, tokens] : configurations(all, 2)) {  // TSan: the first two
     RunOptions o = reference;
     o.workers = w;
     o.tiles = t;
