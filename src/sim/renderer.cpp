@@ -61,8 +61,8 @@ Scene make_scene(const Scenario& s, int index) {
   sc.cy = s.camera.cy;
   sc.baseline = s.camera.baseline_m;
   sc.dt = 1.0 / s.camera.fps;
-  sc.eye = s.ego_velocity_mps * t;
-  sc.eye_prev = s.ego_velocity_mps * (t - sc.dt);
+  sc.eye = ego_position(s, t);
+  sc.eye_prev = ego_position(s, t - sc.dt);
   sc.rot = camera_rotation(s.camera_motion, t);
   sc.rot_prev = camera_rotation(s.camera_motion, t - sc.dt);
   sc.ground_y = s.height_m;
@@ -367,7 +367,7 @@ core::ObstacleTruth turning_collision(const Scenario& s, const Box& box, double 
   for (int i = 0; i <= steps; ++i) {
     const double tau = std::min(i * kStep, e.horizon_s);
     const cv::Matx33d to_camera = camera_rotation(s.camera_motion, t_s + tau).t();
-    const cv::Vec3d eye = s.ego_velocity_mps * (t_s + tau);
+    const cv::Vec3d eye = ego_position(s, t_s + tau);
     const cv::Vec3d c = centre + velocity * tau;
     cv::Vec3d lo(kInf, kInf, kInf), hi(-kInf, -kInf, -kInf);
     for (int k = 0; k < 8; ++k) {

@@ -85,6 +85,15 @@ class YamlReader {
     }
   }
 
+  bool boolean(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsScalar()) fail(node, field, "expected true or false");
+    try {
+      return node.as<bool>();
+    } catch (const YAML::Exception&) {
+      fail(node, field, "expected true or false, got '" + node.Scalar() + "'");
+    }
+  }
+
   int integer(const YAML::Node& node, const std::string& field) const {
     if (!node.IsScalar()) fail(node, field, "expected an integer");
     try {
@@ -185,7 +194,7 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
   if (root.IsNull()) r.fail(root, "(document)", "the file is empty");
   r.expect_map(root, "",
                {"name", "description", "frames", "camera", "height_m", "ego_velocity_mps",
-                "camera_motion", "platform",
+                "ego_follows_heading", "camera_motion", "platform",
                 "background_z_m", "background_height_m", "ground_seed", "background_seed",
                 "noise_sigma", "right_gain", "noise_seed", "edge_samples", "envelope",
                 "min_area_px", "obstacles"});
@@ -198,6 +207,8 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
   if (root["height_m"]) s.height_m = r.number(root["height_m"], "height_m");
   if (root["ego_velocity_mps"])
     s.ego_velocity_mps = r.vec3(root["ego_velocity_mps"], "ego_velocity_mps");
+  if (root["ego_follows_heading"])
+    s.ego_follows_heading = r.boolean(root["ego_follows_heading"], "ego_follows_heading");
   if (root["camera_motion"]) read_camera_motion(r, root["camera_motion"], s.camera_motion);
   if (root["platform"]) s.platform = r.text(root["platform"], "platform");
   if (root["background_z_m"]) s.background_z_m = r.number(root["background_z_m"], "background_z_m");
@@ -274,6 +285,15 @@ cv::Matx33d camera_rotation(const CameraMotion& m, double t_s) {
   const cv::Matx33d rx(1, 0, 0, 0, cp, -sp, 0, sp, cp);
   const cv::Matx33d rz(cr, -sr, 0, sr, cr, 0, 0, 0, 1);
   return ry * rx * rz;
+}
+
+cv::Vec3d ego_position(const Scenario& s, double t_s) {
+  const cv::Vec3d& v = s.ego_velocity_mps;
+  const double w = s.camera_motion.yaw_rate_dps * CV_PI / 180.0;  // rad/s
+  if (!s.ego_follows_heading || w == 0.0) return v * t_s;
+  // The integral of R_y(w tau) v over [0, t]: R_y turns +Z towards +X (camera_rotation).
+  const double sin_part = std::sin(w * t_s) / w, cos_part = (1.0 - std::cos(w * t_s)) / w;
+  return {v[0] * sin_part + v[2] * cos_part, v[1] * t_s, v[2] * sin_part - v[0] * cos_part};
 }
 
 std::vector<std::string> validate(const Scenario& s) {
@@ -391,6 +411,7 @@ std::string to_yaml(const Scenario& s) {
   e << YAML::Key << "height_m" << YAML::Value << to_text(s.height_m);
   e << YAML::Key << "ego_velocity_mps" << YAML::Value;
   vec(s.ego_velocity_mps);
+  e << YAML::Key << "ego_follows_heading" << YAML::Value << s.ego_follows_heading;
   e << YAML::Key << "camera_motion" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "yaw_rate_dps" << YAML::Value << to_text(s.camera_motion.yaw_rate_dps);
   e << YAML::Key << "pitch_amplitude_deg" << YAML::Value

@@ -337,7 +337,9 @@ TEST_F(Cli, StereoFlowAlarmsFarApproachesNeitherEarlyNorLate) {
 // own fit: the box of cold-start, a large face seen well, is trusted from the first frames the
 // noise gate passes and alarms by frame 7 (with a fixed doubt of 0.6 px, at frame 15); the thin
 // pole, whose first frames step by 0.6 px, gets no early alarm from them (with no doubt, 6 early
-// frames: false_alarm_rate 0.082).
+// frames: false_alarm_rate 0.082). Thin-pole is rendered with area-integrated silhouettes (the
+// default edge_samples 4): point-sampled, its disparity steps by half a pixel and it alarms a frame
+// early (0.014).
 TEST_F(Cli, StereoFlowWarnsAtOnceOfAnApproachItsFirstFramesMeasureWell) {
   const Result cold = run("eval --scenario cold-start --json cold.json");
   ASSERT_EQ(cold.status, 0) << cold.err;
@@ -348,7 +350,7 @@ TEST_F(Cli, StereoFlowWarnsAtOnceOfAnApproachItsFirstFramesMeasureWell) {
   const Result pole = run("eval --scenario thin-pole --json pole.json");
   ASSERT_EQ(pole.status, 0) << pole.err;
   const nlohmann::json p = nlohmann::json::parse(slurp(dir_ / "pole.json"));
-  EXPECT_LE(p["false_alarm_rate"].get<double>(), 0.02);
+  EXPECT_LE(p["false_alarm_rate"].get<double>(), 0.01);
   EXPECT_GE(p["recall_settled"].get<double>(), 0.95);
 }
 

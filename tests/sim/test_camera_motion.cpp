@@ -100,6 +100,48 @@ TEST(CameraMotion, TurningInPlaceNeverCollides) {
     for (const auto& o : r.truth(i).obstacles) EXPECT_FALSE(o.colliding) << "frame " << i;
 }
 
+TEST(CameraMotion, FollowingTheHeadingDrivesAnArcThatTheTruthFollowsToo) {
+  // 10 m/s turning right at 20 deg/s: a circle of radius R = v / w about (R, 0, 0).
+  Scenario s = empty_scene();
+  s.ego_velocity_mps = {0, 0, 10.0};
+  s.camera_motion.yaw_rate_dps = 20.0;
+  s.ego_follows_heading = true;
+  const double w = 20.0 * kDeg, radius = 10.0 / w;
+  for (double t : {0.0, 0.5, 1.7, 4.0}) {
+    // The closed form against a fine sum of the heading-turned velocity.
+    cv::Vec3d sum(0, 0, 0);
+    constexpr int kSteps = 20000;
+    for (int i = 0; i < kSteps; ++i) {
+      const double tau = (i + 0.5) * t / kSteps;
+      sum += camera_rotation(s.camera_motion, tau) * s.ego_velocity_mps * (t / kSteps);
+    }
+    const cv::Vec3d p = ego_position(s, t);
+    EXPECT_LT(cv::norm(p - sum), 1e-6) << t;
+    EXPECT_NEAR(cv::norm(p - cv::Vec3d(radius, 0, 0)), radius, 1e-9) << t;
+  }
+  s.ego_follows_heading = false;
+  EXPECT_LT(cv::norm(ego_position(s, 1.7) - cv::Vec3d(0, 0, 17.0)), 1e-12);
+
+  // A post on the arc 60 deg on (30 m of arc, 2.8 s) collides; one as far ahead on the straight
+  // line, 14 m outside the bend by then, does not: the ground truth follows the arc.
+  s.ego_follows_heading = true;
+  s.envelope.horizon_s = 3.0;
+  const double a = 60.0 * kDeg;
+  Box on_arc;
+  on_arc.id = 1;
+  on_arc.size_m = {0.2, 2.0, 0.2};
+  on_arc.position_m = {radius * (1 - std::cos(a)), s.height_m - 1.0, radius * std::sin(a)};
+  Box straight_ahead = on_arc;
+  straight_ahead.id = 2;
+  straight_ahead.position_m[0] = 0.0;
+  const core::ObstacleTruth hit = box_collision(s, on_arc, 0.0);
+  ASSERT_TRUE(hit.colliding);
+  EXPECT_NEAR(*hit.ttc_s, (a * radius - 0.1 - s.envelope.z_contact_m) / 10.0, 0.1);
+  EXPECT_FALSE(box_collision(s, straight_ahead, 0.0).colliding);
+  s.ego_follows_heading = false;  // the camera crabs straight on while it turns
+  EXPECT_FALSE(box_collision(s, on_arc, 0.0).colliding);
+}
+
 TEST(ThinObjects, PoleWidthInPixelsIsFocalTimesWidthOverDistance) {
   // A 5 cm pole whose front face is 5 m ahead: f w / Z = 500 * 0.05 / 5 = 5 px.
   for (double z : {5.0, 10.0}) {

@@ -134,6 +134,7 @@ TEST(Scenario, YamlRoundTripKeepsEveryField) {
   s.obstacles[1].texture_seed = 1234;
   s.camera_motion = {12.5, 2.0, -1.5, 1.75};
   s.platform = "walker";
+  s.ego_follows_heading = true;
   s.obstacles[0].accelerations = {{0.5, {1.0, 0.0, -2.0}}, {1.25, {0, 0, 0}}};
   const std::string path = write_file("roundtrip.yaml", "");
   save_scenario_file(s, path);
@@ -145,6 +146,7 @@ TEST(Scenario, YamlRoundTripKeepsEveryField) {
   EXPECT_EQ(r.camera_motion.roll_amplitude_deg, -1.5);
   EXPECT_EQ(r.camera_motion.oscillation_hz, 1.75);
   EXPECT_EQ(r.platform, "walker");
+  EXPECT_TRUE(r.ego_follows_heading);
   ASSERT_EQ(r.obstacles[0].accelerations.size(), 2u);
   EXPECT_EQ(r.obstacles[0].accelerations[0].from_s, 0.5);
   EXPECT_EQ(r.obstacles[0].accelerations[0].acceleration_mps2, cv::Vec3d(1.0, 0.0, -2.0));
@@ -227,6 +229,7 @@ TEST(Scenario, BadFilesNameTheFileAndField) {
       {"nested.yaml", "envelope:\n  widht: 1\n", "envelope.widht"},
       {"vec.yaml", "ego_velocity_mps: [1, 2]\n", "ego_velocity_mps"},
       {"seed.yaml", "noise_seed: -3\n", "noise_seed"},
+      {"bool.yaml", "ego_follows_heading: sometimes\n", "ego_follows_heading"},
       {"box.yaml", "obstacles:\n  - id: 1\n    size_m: [1, x, 1]\n", "obstacles[0].size_m[1]"},
       {"list.yaml", "obstacles: 3\n", "obstacles"},
       {"notmap.yaml", "- 1\n- 2\n", "expected a mapping"},

@@ -54,6 +54,11 @@ struct CameraMotion {
 /// Camera-to-world rotation of the camera at time t_s (see CameraMotion).
 cv::Matx33d camera_rotation(const CameraMotion& m, double t_s);
 
+struct Scenario;
+/// The camera's position at time t_s, world frame, m (the origin at t = 0): ego_velocity_mps t,
+/// or with ego_follows_heading that velocity turned with the heading's yaw and integrated.
+cv::Vec3d ego_position(const Scenario& s, double t_s);
+
 struct Scenario {
   std::string name;
   std::string description;
@@ -61,6 +66,11 @@ struct Scenario {
   double height_m = 1.2;                  ///< camera height above the ground, m
   cv::Vec3d ego_velocity_mps{0, 0, 0};    ///< camera velocity, world frame, m/s
   CameraMotion camera_motion;             ///< the camera's own rotation (default: none)
+  /// False: the camera moves at ego_velocity_mps in the world frame whatever its yaw (a robot
+  /// turning in place, a camera panning). True: ego_velocity_mps is the velocity in the frame of
+  /// the camera's heading, which turns at camera_motion.yaw_rate_dps, so that the camera drives
+  /// along an arc of radius |v| / yaw rate, as a car does through a bend.
+  bool ego_follows_heading = false;
   /// Platform preset the scenario is made for ("" = none, "robot", "walker", "car";
   /// core::platform_names()): `run` and `eval` apply its detector settings unless --platform or
   /// the config's `platform` key chooses another.
@@ -77,11 +87,10 @@ struct Scenario {
   /// A camera pixel integrates the light over its area: with edge_samples > 1 a pixel where a
   /// surface ends (its centre ray hits another surface or face than a 4-neighbour's) is shaded
   /// as the mean of edge_samples x edge_samples rays spread over the pixel, 1..8; 1 = one ray
-  /// through the centre (point sampling, the default, which the detection figures of
-  /// docs/detectors.md are measured with). Point sampling snaps silhouettes to whole pixels,
-  /// so a thin pole's matched disparity steps instead of growing smoothly as it nears
-  /// (docs/inputs.md, Scenarios).
-  int edge_samples = 1;
+  /// through the centre (point sampling). Point sampling snaps silhouettes to whole pixels, so
+  /// a thin pole's matched disparity steps instead of growing smoothly as it nears, which no
+  /// camera does (docs/inputs.md, Scenarios); hence 4 x 4 by default.
+  int edge_samples = 4;
   std::vector<Box> obstacles;
   core::Envelope envelope;                ///< for the ground-truth collision test
   int min_area_px = 150;                  ///< GT alarm: a colliding obstacle covers at least this
