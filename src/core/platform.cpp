@@ -16,13 +16,15 @@ struct Preset {
   double stereo_z_max_m;
   double scene_flow_z_max_m;
   double ground_z_max_m;
+  bool predict_turn;  ///< scene_flow.predict_turn: the platform drives where it heads
 };
 
 const std::vector<Preset>& presets() {
   static const DetectorParams kDefaults;
   static const std::vector<Preset> kAll = {
       {"robot", kDefaults.envelope, kDefaults.bm.num_disparities, kDefaults.stereo.z_max_m,
-       kDefaults.scene_flow.z_max_m, kDefaults.scene_flow.ground.z_max_m},
+       kDefaults.scene_flow.z_max_m, kDefaults.scene_flow.ground.z_max_m,
+       kDefaults.scene_flow.predict_turn},
       {"walker",
        Envelope{.half_width_m = 0.35,
                 .y_top_m = -0.7,
@@ -30,14 +32,14 @@ const std::vector<Preset>& presets() {
                 .z_contact_m = 0.4,
                 .horizon_s = 3.0},
        kDefaults.bm.num_disparities, kDefaults.stereo.z_max_m, kDefaults.scene_flow.z_max_m,
-       kDefaults.scene_flow.ground.z_max_m},
+       kDefaults.scene_flow.ground.z_max_m, kDefaults.scene_flow.predict_turn},
       {"car",
        Envelope{.half_width_m = 1.0,
                 .y_top_m = -0.4,
                 .y_bottom_m = 1.1,
                 .z_contact_m = 2.0,
                 .horizon_s = 3.0},
-       128, 40.0, 60.0, 40.0},
+       128, 40.0, 60.0, 40.0, true},
   };
   return kAll;
 }
@@ -68,6 +70,7 @@ void apply_platform(const std::string& name, DetectorParams& params) {
   params.stereo.z_max_m = p.stereo_z_max_m;
   params.scene_flow.z_max_m = p.scene_flow_z_max_m;
   params.scene_flow.ground.z_max_m = p.ground_z_max_m;
+  params.scene_flow.predict_turn = p.predict_turn;
 }
 
 }  // namespace sg::core

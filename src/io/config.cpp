@@ -212,6 +212,7 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("chain_stride_z_m", p.scene_flow.chain_stride_z_m)
         .field("grow_into_edges", p.scene_flow.grow_into_edges)
         .field("compensate_rotation", p.scene_flow.compensate_rotation)
+        .field("predict_turn", p.scene_flow.predict_turn)
         .field("longest_gap_decides", p.scene_flow.longest_gap_decides)
         .field("fit_velocity", p.scene_flow.fit_velocity)
         .field("use_envelope_band", p.scene_flow.use_envelope_band)

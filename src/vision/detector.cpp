@@ -164,6 +164,12 @@ LabelJob Detector::prepare(const core::StereoFrame& frame, FrameMaps maps) {
         job.derotations_.push_back(chain);
       }
     }
+    if (derotate && params_.scene_flow.predict_turn && !job.derotations_.empty()) {
+      // The yaw of the longest gap's rotation: it turns camera i-k's coordinates into camera
+      // i's, so a camera turning right by a turns points by -a.
+      const cv::Matx33d& r = job.derotations_.back();
+      job.yaw_rate_rps_ = -std::atan2(r(0, 2), r(2, 2)) / job.spans_s_.back();
+    }
     allocate_stereo_flow_outputs(disp.size(), job.danger_, job.ttc_, job.velocity_);
     // Over the first frames of a chain (short of the longest gap) the disparity error dominates
     // the fit: its residuals at each sample time (now, and each past frame of the chain once;
@@ -239,7 +245,7 @@ void LabelJob::conclude() {
     const double span_s =
         spans_s_.empty() ? 0.0 : *std::max_element(spans_s_.begin(), spans_s_.end());
     pool_surface_motion(disparity_, *camera_, p.envelope, sf, span_s, edges_, danger_, ttc_,
-                        velocity_, startup_);
+                        velocity_, startup_, yaw_rate_rps_);
     startup_ = ChainResiduals{};  // a float a pixel per sample: not kept past the frame
   }
   if (flow_mode_ && sf.grow_into_edges)

@@ -28,9 +28,9 @@ inline bool split(float v, int n, int& i, float& f) {
 void check_same(const cv::Mat& ref, const cv::Mat& m, int type, const char* what) {
   if (m.type() != type || m.size() != ref.size()) {
     std::ostringstream s;
-    s << "scene flow: " << what << " must be " << cv::typeToString(type) << " of size "
-      << ref.cols << "x" << ref.rows << " (got " << cv::typeToString(m.type()) << " "
-      << m.cols << "x" << m.rows << ")";
+    s << "scene flow: " << what << " must be " << cv::typeToString(type) << " of size " << ref.cols
+      << "x" << ref.rows << " (got " << cv::typeToString(m.type()) << " " << m.cols << "x" << m.rows
+      << ")";
     throw core::InputError(s.str());
   }
 }
@@ -199,8 +199,7 @@ void mark_depth_edges(const cv::Mat& disp, int margin_px, double step_px, cv::Ma
   }
 }
 
-bool sample_disparity_bilinear(const cv::Mat& disp, float x, float y, float& out,
-                               float max_step) {
+bool sample_disparity_bilinear(const cv::Mat& disp, float x, float y, float& out, float max_step) {
   int x0, y0;
   float fx, fy;
   if (!split(x, disp.cols, x0, fx) || !split(y, disp.rows, y0, fy)) return false;
@@ -265,6 +264,47 @@ bool heads_into_envelope(const cv::Point3d& P, const cv::Vec3d& V, const core::E
   return true;
 }
 
+bool heads_into_envelope_turning(const cv::Point3d& P, const cv::Vec3d& V, double yaw_rate_rps,
+                                 const core::Envelope& e, double v_min, double& t_contact) {
+  const double w = yaw_rate_rps;
+  if (w == 0.0) return heads_into_envelope(P, V, e, v_min, t_contact);
+  if (!(V[2] <= -v_min) || !(P.z > e.z_contact_m)) return false;
+  // P(t) - C turns counter-clockwise in (X, Z) by w t: (x, z) -> (x cos - z sin, x sin + z cos).
+  const double cx = -V[2] / w, cz = V[0] / w;
+  const double dx = P.x - cx, dz = P.z - cz;
+  const double h = e.z_contact_m - cz;  // the contact plane, relative to C
+  const double r2 = dx * dx + dz * dz;
+  // Cheap refusals first (most pixels): Z falls no faster than the speed |w| r on the circle, so
+  // the plane is at least (P_z - z_contact) / (|w| r) away; and the crossing is one of the two
+  // points where the circle meets the plane, both outside the envelope's width here.
+  const double to_plane = P.z - e.z_contact_m, reach = e.horizon_s * w;
+  if (to_plane * to_plane > reach * reach * r2) return false;
+  const double s2 = r2 - h * h;
+  if (!(s2 >= 0.0)) return false;  // its circle never reaches the plane
+  const double s = std::sqrt(s2);
+  if (std::abs(cx + s) > e.half_width_m && std::abs(cx - s) > e.half_width_m) return false;
+  // The first of the two crossings along the travel: the smaller angle from (dx, dz) to
+  // (qx, h) in the direction of travel, compared by a pseudo-angle that grows with it over
+  // [0, 2 pi) (atan2 only for the one chosen).
+  const auto along = [&](double qx, double& sine, double& cosine) {
+    sine = (w < 0.0 ? -1.0 : 1.0) * (dx * h - dz * qx);
+    cosine = dx * qx + dz * h;
+    const double p = cosine / (std::abs(sine) + std::abs(cosine));
+    return sine >= 0.0 ? 1.0 - p : 3.0 + p;
+  };
+  double sin_a = 0.0, cos_a = 0.0, sin_b = 0.0, cos_b = 0.0;
+  const bool first = along(s, sin_a, cos_a) <= along(-s, sin_b, cos_b);
+  const double best_x = cx + (first ? s : -s);
+  double a = first ? std::atan2(sin_a, cos_a) : std::atan2(sin_b, cos_b);
+  if (a < 0.0) a += 2.0 * CV_PI;
+  const double best = a / std::abs(w);
+  if (!(best > 0.0) || best > e.horizon_s) return false;
+  const double y = P.y + V[1] * best;
+  if (std::abs(best_x) > e.half_width_m || y < e.y_top_m || y > e.y_bottom_m) return false;
+  t_contact = best;
+  return true;
+}
+
 std::vector<int> sampled_gaps(const SceneFlowParams& p) {
   if (!p.fit_velocity || p.gaps.empty()) return p.gaps;
   std::vector<int> all(
@@ -274,9 +314,8 @@ std::vector<int> sampled_gaps(const SceneFlowParams& p) {
 }
 
 void label_stereo_flow(const cv::Mat& disp_cur, const cv::Mat& disp_prev, const cv::Mat& flow,
-                       const core::Camera& cam, const core::Envelope& env,
-                       const SceneFlowParams& p, double dt, cv::Mat& danger, cv::Mat& ttc,
-                       cv::Mat& velocity) {
+                       const core::Camera& cam, const core::Envelope& env, const SceneFlowParams& p,
+                       double dt, cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity) {
   SceneFlowParams one = p;
   one.gaps = {1};
   label_stereo_flow_window(disp_cur, {&disp_prev}, {&flow}, cam, env, one, dt, danger, ttc,
@@ -394,8 +433,7 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
       ttc_row[x] = kNaN;
       vel_row[x] = unknown;
       if (d_row[x] > 0.0f && d_row[x] >= d_min && edge_row[x] == 0 &&
-          strides.followed(x, y, d_row[x]) &&
-          (!p.use_envelope_band || in_band(y, d_row[x]))) {
+          strides.followed(x, y, d_row[x]) && (!p.use_envelope_band || in_band(y, d_row[x]))) {
         q[x] = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
         live.push_back(x);
         if (p.fit_velocity) fits[x].reset(test.point(static_cast<float>(x), fy, d_row[x]));

@@ -352,7 +352,7 @@ double slope_doubt(const std::vector<double>& times_s, const std::vector<double>
 void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const core::Envelope& env,
                          const core::SceneFlowParams& p, double span_s, const cv::Mat& edges,
                          cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity,
-                         const ChainResiduals& startup) {
+                         const ChainResiduals& startup, double yaw_rate_rps) {
   if (disp.type() != CV_32FC1 || edges.type() != CV_8UC1 || danger.type() != CV_8UC1 ||
       ttc.type() != CV_32FC1 || velocity.type() != CV_32FC3 || edges.size() != disp.size() ||
       danger.size() != disp.size() || ttc.size() != disp.size() || velocity.size() != disp.size())
@@ -476,7 +476,7 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
                    doubt);
   }
   // Every candidate of a tested surface, a run of one surface's pixels at a time (SIMD).
-  const SurfaceTest test = make_surface_test(cam, env, p, span_s);
+  const SurfaceTest test = make_surface_test(cam, env, p, span_s, yaw_rate_rps);
   for (int y = 0; y < disp.rows; ++y) {
     const int* l = labels.ptr<int>(y);
     const float* d = disp.ptr<float>(y);

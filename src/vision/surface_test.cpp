@@ -4,6 +4,7 @@
 // twice, and the kernel must equal the reference bit for bit.
 #include "sg/vision/surface_test.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -86,7 +87,7 @@ HWY_EXPORT(CurrentTarget);
 }  // namespace surface_detail
 
 SurfaceTest make_surface_test(const core::Camera& cam, const core::Envelope& env,
-                              const core::SceneFlowParams& p, double span_s) {
+                              const core::SceneFlowParams& p, double span_s, double yaw_rate_rps) {
   SurfaceTest k;
   k.cx = cam.cx;
   k.cy = cam.cy;
@@ -95,6 +96,12 @@ SurfaceTest make_surface_test(const core::Camera& cam, const core::Envelope& env
   k.span_s = span_s;
   k.min_delta_d_px = p.min_delta_d_px;
   k.v_min_mps = p.v_min_mps;
+  k.yaw_rate_rps = yaw_rate_rps;
+  // The fit's slope is the velocity at the middle of its span, in today's orientation: in a turn
+  // the platform then headed yaw_rate span / 2 the other way, so the test turns V on by that.
+  const double a = -yaw_rate_rps * span_s / 2.0;
+  k.turn_cos = std::cos(a);
+  k.turn_sin = std::sin(a);
   k.envelope = env;
   return k;
 }
@@ -115,8 +122,35 @@ void test_surface_run_reference(const SurfaceTest& k, const cv::Vec3d& V, double
   }
 }
 
+void test_surface_run_turning(const SurfaceTest& k, const cv::Vec3d& V, double keep, int y, int x0,
+                              int x1, const float* d, float* ttc) {
+  std::fill(ttc + x0, ttc + x1, std::numeric_limits<float>::quiet_NaN());
+  cv::Vec3d kept = V * keep;
+  kept = {k.turn_cos * kept[0] - k.turn_sin * kept[2], kept[1],
+          k.turn_sin * kept[0] + k.turn_cos * kept[2]};
+  if (!(kept[2] <= -k.v_min_mps) || !(V[2] < 0.0)) return;  // no pixel of the run can pass
+  // The noise gate as a least disparity: with b = -V_z span / (f B) > 0 the disparity span_s ago
+  // was d / (1 + b d), and d - d / (1 + b d) >= m  <=>  b d^2 - m b d - m >= 0.
+  const double b = -V[2] * k.span_s / k.fb, m = k.min_delta_d_px;
+  const double d_least =
+      m <= 0.0 ? 0.0 : (m * b + std::sqrt(m * m * b * b + 4.0 * m * b)) / (2.0 * b);
+  for (int x = x0; x < x1; ++x) {
+    const double disp = d[x];
+    if (!(disp > 0.0) || disp < d_least) continue;
+    const double z = k.fb / disp;
+    const cv::Point3d P((x - k.cx) * z / k.focal_px, (y - k.cy) * z / k.focal_px, z);
+    double t_c = 0.0;
+    if (heads_into_envelope_turning(P, kept, k.yaw_rate_rps, k.envelope, k.v_min_mps, t_c))
+      ttc[x] = static_cast<float>(t_c * keep);  // the TTC of V itself
+  }
+}
+
 void test_surface_run(const SurfaceTest& k, const cv::Vec3d& V, double keep, int y, int x0, int x1,
                       const float* d, float* ttc) {
+  if (k.yaw_rate_rps != 0.0) {
+    test_surface_run_turning(k, V, keep, y, x0, x1, d, ttc);
+    return;
+  }
   const int tail =
       HWY_DYNAMIC_DISPATCH(surface_detail::TestRunVectors)(k, V, keep, y, x0, x1, d, ttc);
   test_surface_run_reference(k, V, keep, y, tail, x1, d, ttc);

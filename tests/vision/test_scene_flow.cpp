@@ -170,6 +170,76 @@ TEST(HeadsIntoEnvelope, HandComputedCases) {
   EXPECT_FALSE(heads_into_envelope({0.0, 0.0, 0.4}, {0, 0, -2}, e, v_min, t));
 }
 
+TEST(HeadsIntoEnvelopeTurning, AStaticPointMeetsThePlatformOnlyOnItsArc) {
+  // A car at 10 m/s turning right at 20 deg/s drives a circle of radius R about (R, 0, 0).
+  core::Envelope e;
+  e.half_width_m = 1.0;
+  e.y_top_m = -0.4;
+  e.y_bottom_m = 1.1;
+  e.z_contact_m = 2.0;
+  e.horizon_s = 3.0;
+  const double w = 20.0 * CV_PI / 180.0, radius = 10.0 / w;
+  const cv::Vec3d still(0, 0, -10.0);  // a static point's velocity without the rotation
+  double t = -1.0;
+  // On the arc 45 deg on (22.5 m of arc): met after the arc to the contact plane.
+  const double a = 45.0 * CV_PI / 180.0;
+  const cv::Point3d on_arc(radius * (1 - std::cos(a)), 0.5, radius * std::sin(a));
+  ASSERT_TRUE(heads_into_envelope_turning(on_arc, still, w, e, 0.1, t));
+  // Contact when the point's camera depth, R sin(arc angle left), is z_contact.
+  const double left = std::asin(e.z_contact_m / radius);
+  EXPECT_NEAR(t, (a - left) * radius / 10.0, 1e-6);
+  // The straight line would meet it nowhere (it is 8.4 m to the right)...
+  EXPECT_FALSE(heads_into_envelope(on_arc, still, e, 0.1, t));
+  // ... and a point straight ahead, which the straight line meets, is passed by.
+  const cv::Point3d ahead(0.0, 0.5, radius * std::sin(a));
+  EXPECT_TRUE(heads_into_envelope(ahead, still, e, 0.1, t));
+  EXPECT_FALSE(heads_into_envelope_turning(ahead, still, w, e, 0.1, t));
+  // Mirrored: a left turn meets the mirrored point after the same time.
+  double t_left = -1.0;
+  ASSERT_TRUE(heads_into_envelope_turning({-on_arc.x, on_arc.y, on_arc.z}, still, -w, e, 0.1,
+                                          t_left));
+  EXPECT_NEAR(t_left, (a - left) * radius / 10.0, 1e-6);
+  // Out of the horizon, out of the band, receding or too slow: no.
+  const double b = 120.0 * CV_PI / 180.0;
+  EXPECT_FALSE(heads_into_envelope_turning({radius * (1 - std::cos(b)), 0.5, radius * std::sin(b)},
+                                           still, w, e, 0.1, t));
+  EXPECT_FALSE(heads_into_envelope_turning({on_arc.x, -2.0, on_arc.z}, still, w, e, 0.1, t));
+  EXPECT_FALSE(heads_into_envelope_turning(on_arc, -still, w, e, 0.1, t));
+  EXPECT_FALSE(heads_into_envelope_turning(on_arc, {0, 0, -0.05}, w, e, 0.1, t));
+}
+
+TEST(HeadsIntoEnvelopeTurning, ASlowTurnAgreesWithTheStraightLine) {
+  // 0.001 deg/s: the arc leaves the line by millimetres over the horizon; verdicts agree except
+  // within them of the envelope's edges, and TTCs agree.
+  core::Envelope e;
+  const double w = 0.001 * CV_PI / 180.0;
+  cv::RNG rng(5);
+  int both = 0, compared = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const cv::Point3d P(rng.uniform(-3.0, 3.0), rng.uniform(-1.0, 1.0), rng.uniform(0.2, 15.0));
+    const cv::Vec3d V(rng.uniform(-1.0, 1.0), rng.uniform(-0.3, 0.3), rng.uniform(-6.0, 1.0));
+    double t_line = -1.0, t_arc = -1.0;
+    const bool line = heads_into_envelope(P, V, e, 0.1, t_line);
+    const bool arc = heads_into_envelope_turning(P, V, w, e, 0.1, t_arc);
+    if (line != arc) {
+      // Only where the line passes within 5 mm of the envelope's side or horizon.
+      const double t_c = (P.z - e.z_contact_m) / -V[2];
+      const double x = P.x + V[0] * t_c;
+      EXPECT_TRUE(std::abs(std::abs(x) - e.half_width_m) < 5e-3 ||
+                  std::abs(t_c - e.horizon_s) < 1e-3)
+          << P << " " << V;
+      continue;
+    }
+    ++compared;
+    if (line) {
+      ++both;
+      EXPECT_NEAR(t_arc, t_line, 1e-3 * t_line) << P << " " << V;
+    }
+  }
+  EXPECT_GT(compared, 19900);
+  EXPECT_GT(both, 500);  // the sample does reach the envelope
+}
+
 TEST(SceneFlowParams, Validate) {
   EXPECT_TRUE(validate(SceneFlowParams{}).empty());
   SceneFlowParams p;

@@ -287,6 +287,13 @@ struct SceneFlowParams {
   /// false_alarm_rate 0.020); with the left-right check and obstacle confirmation it gives none
   /// there, and no built-in scenario or shared recording loses an alarm frame with it.
   bool compensate_rotation = true;
+  /// With compensate_rotation: the envelope test follows the platform's turn (the yaw rate of
+  /// that rotation estimate over the longest gap): a point is dangerous when it meets the contact
+  /// plane on the arc the platform drives, not on the straight line ahead
+  /// (vision::heads_into_envelope_turning). That holds for a platform that drives where it
+  /// heads, as a car does (on in the car preset); a camera that pans or a platform that crabs
+  /// while it moves straight needs the straight line (off: the default, robot and walker).
+  bool predict_turn = false;
   /// How the gaps combine per pixel. true: the longest gap that gives the pixel a velocity decides
   /// alone (its verdict, TTC and velocity), the temporal integration of DESIGN 3.2: a longer gap
   /// divides the disparity noise by its length, and the shorter gaps only speak where the chain

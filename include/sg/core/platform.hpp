@@ -22,9 +22,10 @@ Envelope platform_envelope(const std::string& name);
 
 /// Sets the fields a platform governs, whatever they held before (so presets can be applied
 /// over one another): envelope; bm.num_disparities; stereo.z_max_m; scene_flow.z_max_m,
-/// scene_flow.ground.z_max_m. robot and walker keep the defaults (64 disparities, 12 / 20 / 12 m);
-/// car: 128 disparities (nearest depth f*B/128, 1.4 m at f 600 px, B 0.30 m), 40 / 60 / 40 m
-/// (a stopped car is 3 s away at 32 m at 10 m/s). "" leaves `params` as it is.
+/// scene_flow.ground.z_max_m; scene_flow.predict_turn. robot and walker keep the defaults (64
+/// disparities, 12 / 20 / 12 m, the straight line ahead); car: 128 disparities (nearest depth
+/// f*B/128, 1.4 m at f 600 px, B 0.30 m), 40 / 60 / 40 m (a stopped car is 3 s away at 32 m at
+/// 10 m/s), and the arc it drives through a bend. "" leaves `params` as it is.
 /// Throws InputError naming the known platforms for an unknown name.
 void apply_platform(const std::string& name, DetectorParams& params);
 

@@ -81,6 +81,9 @@ class LabelJob {
   /// Stereo-Flow with scene_flow.compensate_rotation: turns past_[j]'s camera coordinates into
   /// the current orientation; empty = no compensation.
   std::vector<cv::Matx33d> derotations_;
+  /// Stereo-Flow with scene_flow.predict_turn: the platform's yaw rate over the longest gap,
+  /// rad/s (+ = turning right); 0 = the envelope test looks straight ahead.
+  double yaw_rate_rps_ = 0.0;
   cv::Mat danger_, ttc_, velocity_;
   // The surveyed detectors: the left images compared (relative-size: the earlier one of the
   // gap; sceneflow-seg: the current one), and the time between the frames compared, s; 0 when

@@ -41,6 +41,17 @@ bool point_velocity(cv::Point2f p, float d_cur, cv::Point2f q, float d_prev,
 bool heads_into_envelope(const cv::Point3d& P, const cv::Vec3d& V, const core::Envelope& e,
                          double v_min, double& t_contact);
 
+/// heads_into_envelope for a platform turning at yaw_rate_rps (rad/s, + = the camera turns right,
+/// +Z towards +X; 0 = heads_into_envelope itself). V is the point's velocity without the camera's
+/// rotation (the derotated fit); in the camera's frame the point then circles the fixed point C
+/// of dP/dt = V - w (P_z, 0, -P_x), C = (-V_z / w, V_x / w) in (X, Z), while Y moves at V_y.
+/// True when V_z <= -v_min, P_z > z_contact and the point's first crossing of the contact plane
+/// Z = z_contact, at t_c <= horizon, lies inside the envelope; t_contact = t_c, s. A static point
+/// beside a bend thus passes the platform, which follows the bend, and one on the arc ahead
+/// does not.
+bool heads_into_envelope_turning(const cv::Point3d& P, const cv::Vec3d& V, double yaw_rate_rps,
+                                 const core::Envelope& e, double v_min, double& t_contact);
+
 /// 255 where p lies within margin_px of a depth edge: the largest and smallest valid (>= 0)
 /// disparities of the (2 margin + 1)^2 window around p differ by more than step_px; 0 elsewhere
 /// (everywhere when margin_px <= 0). disp: CV_32F, invalid < 0; mask: CV_8U, allocated.

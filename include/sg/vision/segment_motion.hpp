@@ -103,10 +103,11 @@ double slope_doubt(const std::vector<double>& times_s, const std::vector<double>
 /// p.startup_doubt_se), and the envelope test uses V (1 - sigma_V / -V_z) instead of V (nothing
 /// when that is <= 0; nothing either with fewer than three samples); the TTC reported is that of
 /// V itself. A large surface seen well is thus trusted from its first frames, a few pixels whose
-/// disparity steps are not.
+/// disparity steps are not. yaw_rate_rps (rad/s, + = turning right): the platform's turn, which
+/// the envelope test follows (heads_into_envelope_turning); 0 = straight ahead.
 void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const core::Envelope& env,
                          const core::SceneFlowParams& p, double span_s, const cv::Mat& edges,
                          cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity,
-                         const ChainResiduals& startup = {});
+                         const ChainResiduals& startup = {}, double yaw_rate_rps = 0.0);
 
 }  // namespace sg::vision
