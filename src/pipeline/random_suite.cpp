@@ -33,7 +33,7 @@ double percentile(const std::vector<double>& sorted, double p) {
   return sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
 }
 
-nlohmann::json to_json(const Distribution& d) {
+nlohmann::json distribution_json(const Distribution& d) {
   return {{"count", d.count}, {"mean", d.mean}, {"p10", d.p10}, {"p50", d.p50}, {"p90", d.p90}};
 }
 
@@ -278,11 +278,11 @@ nlohmann::json RandomSuiteResult::to_json() const {
   j["summary"] = {{"scenes", s.scenes},
                   {"colliding", s.colliding},
                   {"clear", s.clear},
-                  {"recall_settled", to_json(s.recall_settled)},
-                  {"lead_s", to_json(s.lead_s)},
+                  {"recall_settled", distribution_json(s.recall_settled)},
+                  {"lead_s", distribution_json(s.lead_s)},
                   {"missed", s.missed},
-                  {"first_alarm_delay_s", to_json(s.first_alarm_delay_s)},
-                  {"false_alarm_rate", to_json(s.false_alarm_rate)},
+                  {"first_alarm_delay_s", distribution_json(s.first_alarm_delay_s)},
+                  {"false_alarm_rate", distribution_json(s.false_alarm_rate)},
                   {"worst_seeds", s.worst_seeds},
                   {"wall_s", s.wall_s}};
   j["scenes"] = rows;

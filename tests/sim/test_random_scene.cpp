@@ -64,8 +64,12 @@ TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
     EXPECT_EQ(s.platform, info.platform == "drone" ? "robot" : info.platform);
     EXPECT_TRUE(within(s.height_m, r.height_m[p]));
     const double speed = s.ego_velocity_mps[2];
-    if (info.ego_motion == "still") EXPECT_EQ(speed, 0.0);
-    if (info.ego_motion == "forward") EXPECT_TRUE(within(speed, r.ego_speed_mps[p]));
+    if (info.ego_motion == "still") {
+      EXPECT_EQ(speed, 0.0);
+    }
+    if (info.ego_motion == "forward") {
+      EXPECT_TRUE(within(speed, r.ego_speed_mps[p]));
+    }
     if (info.ego_motion == "turning") {
       EXPECT_TRUE(within(std::abs(s.camera_motion.yaw_rate_dps), r.yaw_rate_dps));
       EXPECT_TRUE(within(speed, {0.0, r.ego_speed_mps[p].hi}));
