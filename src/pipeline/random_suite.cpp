@@ -84,7 +84,7 @@ void draw_histogram(cv::Mat panel, const std::vector<double>& values, double bin
     ++counts[static_cast<std::size_t>(std::clamp(static_cast<int>(v / bin), 0, bins - 1))];
   const int bars = bins + (extra_label.empty() ? 0 : 1);
   const int highest = std::max(1, std::max(extra, *std::max_element(counts.begin(), counts.end())));
-  const int left = 40, right = panel.cols - 10, top = 40, bottom = panel.rows - 50;
+  const int left = 40, right = panel.cols - 30, top = 60, bottom = panel.rows - 50;
   const double width = static_cast<double>(right - left) / bars;
   const auto font = cv::FONT_HERSHEY_SIMPLEX;
   cv::putText(panel, title, {left, 25}, font, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
