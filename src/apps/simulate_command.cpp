@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "sg/core/error.hpp"
 #include "sg/io/stereo_folder.hpp"
 #include "sg/sim/random_scene.hpp"
@@ -17,6 +18,7 @@ struct SimulateArgs {
   std::optional<int> frames;
   bool random = false;
   std::optional<long long> seed;
+  std::string max_size;  ///< "WxH": scale a larger scene down to fit (as eval --suite does)
 };
 
 /// The scenario the flags name: --scenario, or --random with --seed.
@@ -41,6 +43,12 @@ void simulate_main(const SimulateArgs& args) {
       throw core::InputError("frames=" + std::to_string(*args.frames) + ": must be >= 2");
     }
     scenario.frames = *args.frames;
+  }
+  if (!args.max_size.empty()) {
+    const cv::Size cap = parse_size(args.max_size, "max-size", "320x240");
+    if (cap.width < 32 || cap.height < 32)
+      throw core::InputError("max-size=" + args.max_size + ": each side must be >= 32");
+    sim::cap_scenario(scenario, cap, 0);
   }
   const sim::Renderer renderer(scenario);
   io::FolderWriter writer(args.out, scenario.camera, /*with_truth=*/true);
@@ -76,6 +84,9 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_flag("--random", args->random,
                 "a generated scene instead (with --seed; docs/random-suite.md)");
   cmd->add_option("--seed", args->seed, "with --random: the scene's seed, 0..4294967295");
+  cmd->add_option("--max-size", args->max_size,
+                  "scale a larger scene down to fit WxH (the scene eval --suite random "
+                  "--max-size scores)");
   cmd->add_option("--out", args->out, "output folder")->required();
   cmd->add_option("--frames", args->frames, "render only the first N frames");
   cmd->callback([args] { simulate_main(*args); });
