@@ -32,7 +32,8 @@ sim::Scenario chosen_scenario(const SimulateArgs& args) {
     return sim::random_scenario(static_cast<std::uint32_t>(*args.seed));
   }
   if (args.seed) throw core::InputError("--seed needs --random");
-  if (args.scenario.empty()) throw core::InputError("give --scenario NAME|FILE or --random --seed S");
+  if (args.scenario.empty())
+    throw core::InputError("give --scenario NAME|FILE or --random --seed S");
   return sim::resolve_scenario(args.scenario);
 }
 

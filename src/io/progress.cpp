@@ -25,7 +25,8 @@ std::string progress_line(int done, int total, double elapsed_s, const std::stri
   }
   if (elapsed_s > 0 && done > 0) {
     const double fps = done / elapsed_s;
-    s << "  " << std::fixed << std::setprecision(1) << fps << (unit == "frames" ? std::string(" fps") : " " + unit + "/s");
+    s << "  " << std::fixed << std::setprecision(1) << fps
+      << (unit == "frames" ? std::string(" fps") : " " + unit + "/s");
     if (total > 0) {
       const long left = std::lround(std::max(0, total - done) / fps);
       s << "  ETA " << left / 60 << ':' << std::setw(2) << std::setfill('0') << left % 60;
