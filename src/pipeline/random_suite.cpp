@@ -296,15 +296,24 @@ std::string RandomSuiteResult::table() const {
   std::snprintf(line, sizeof(line), "scenes %d (colliding %d, clear %d) in %.1f s\n", s.scenes,
                 s.colliding, s.clear, s.wall_s);
   out << line;
-  std::snprintf(line, sizeof(line),
-                "colliding: recall_settled mean %.3f p10 %.3f; lead p10 %.2f s median %.2f s "
-                "(%d warned, %d missed); first alarm after the horizon p90 %.2f s (%d)\n",
-                s.recall_settled.mean, s.recall_settled.p10, s.lead_s.p10, s.lead_s.p50,
-                s.lead_s.count, s.missed, s.first_alarm_delay_s.p90, s.first_alarm_delay_s.count);
-  out << line;
-  std::snprintf(line, sizeof(line), "clear: false alarm rate mean %.3f p90 %.3f\n",
-                s.false_alarm_rate.mean, s.false_alarm_rate.p90);
-  out << line;
+  // A distribution over no scene reads "-".
+  const auto figure = [](const Distribution& d, double value, const char* format) {
+    if (d.count == 0) return std::string("-");
+    char text[32];
+    std::snprintf(text, sizeof(text), format, value);
+    return std::string(text);
+  };
+  out << "colliding: recall_settled mean "
+      << figure(s.recall_settled, s.recall_settled.mean, "%.3f") << " p10 "
+      << figure(s.recall_settled, s.recall_settled.p10, "%.3f") << "; lead p10 "
+      << figure(s.lead_s, s.lead_s.p10, "%.2f s") << " median "
+      << figure(s.lead_s, s.lead_s.p50, "%.2f s") << " (" << s.lead_s.count << " warned, "
+      << s.missed << " missed); first alarm after the horizon p90 "
+      << figure(s.first_alarm_delay_s, s.first_alarm_delay_s.p90, "%.2f s") << " ("
+      << s.first_alarm_delay_s.count << ")\n";
+  out << "clear: false alarm rate mean "
+      << figure(s.false_alarm_rate, s.false_alarm_rate.mean, "%.3f") << " p90 "
+      << figure(s.false_alarm_rate, s.false_alarm_rate.p90, "%.3f") << "\n";
   if (!s.worst_seeds.empty())
     out << "worst scenes (stereoguard simulate --random --seed S --out DIR):\n";
   for (std::uint32_t seed : s.worst_seeds) {
