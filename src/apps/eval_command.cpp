@@ -9,6 +9,7 @@
 
 #include "commands.hpp"
 #include "eval_stereo.hpp"
+#include "eval_suite.hpp"
 #include "eval_truth.hpp"
 #include "options.hpp"
 #include "outputs.hpp"
@@ -44,6 +45,8 @@ struct EvalArgs {
   std::string truth, distance_column, baseline;
   std::optional<double> due_within_m;
   std::optional<std::string> quiet_phases;
+  // --suite random: the randomised scene suite (suite.detector, quiet and json are copied over).
+  SuiteEvalArgs suite;
 };
 
 /// Two images and the forward GT flow from the first to the second.
@@ -174,6 +177,18 @@ void eval_flow_main(const EvalArgs& args) {
 }
 
 void eval_main(const EvalArgs& args) {
+  if (!args.suite.suite.empty()) {
+    SuiteEvalArgs suite = args.suite;
+    suite.detector = args.detector;
+    suite.quiet = args.quiet;
+    suite.json = args.json;
+    eval_suite_main(suite);
+    return;
+  }
+  if (args.suite.count || args.suite.seed || !args.suite.max_size.empty() ||
+      args.suite.max_frames != 0 || args.suite.jobs != 0 || !args.suite.plot.empty())
+    throw core::InputError("--count, --seed, --max-size, --max-frames, --jobs and --plot need "
+                           "--suite random");
   if (args.flow) {
     eval_flow_main(args);
     return;
@@ -327,6 +342,21 @@ void add_eval_command(CLI::App& app) {
                   "(default bm,sgbm,fast,fast-census)");
   cmd->add_option("--flow-methods", args->flow_methods,
                   "with --flow: dis-ultrafast, dis-fast, dis-medium, farneback or all (default)");
+  auto* suite_option = cmd->add_option(
+      "--suite", args->suite.suite,
+      "score a suite of generated scenes instead: 'random' (seeds --seed .. --seed + --count - "
+      "1; docs/random-suite.md)");
+  suite_option->excludes(flow_flag)->excludes(truth_option)->excludes(baseline_option);
+  cmd->add_option("--count", args->suite.count, "with --suite: number of scenes (>= 1)");
+  cmd->add_option("--seed", args->suite.seed, "with --suite: the first scene's seed");
+  cmd->add_option("--max-size", args->suite.max_size,
+                  "with --suite: scale larger scenes down to fit WxH (e.g. 320x240 for CI)");
+  cmd->add_option("--max-frames", args->suite.max_frames,
+                  "with --suite: render at most N frames per scene (0 = all)");
+  cmd->add_option("--jobs", args->suite.jobs,
+                  "with --suite: scenes scored at once (default 0 = all cores)");
+  cmd->add_option("--plot", args->suite.plot,
+                  "with --suite: draw the lead and false-alarm histograms to this PNG");
   cmd->callback([args] { eval_main(*args); });
 }
 

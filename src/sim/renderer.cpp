@@ -6,6 +6,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include "sg/core/error.hpp"
 #include "texture.hpp"
 
@@ -350,6 +353,51 @@ void check_index(const Scenario& s, int index) {
                             "' (0.." + std::to_string(s.frames - 1) + ")");
 }
 
+/// Exposure gain at time t_s: that of the last step started, else 1.
+double exposure_gain(const ImageEffects& fx, double t_s) {
+  double gain = 1.0;
+  for (const ExposureStep& step : fx.exposure_steps)
+    if (step.from_s <= t_s) gain = step.gain;
+  return gain;
+}
+
+/// Applies Scenario::effects to one rendered pair (see ImageEffects for the order).
+void apply_effects(const ImageEffects& fx, double t_s, cv::Mat& left, cv::Mat& right) {
+  const double gain = exposure_gain(fx, t_s);
+  if (gain != 1.0 || fx.vignetting != 0.0) {
+    cv::Mat factor(left.size(), CV_32FC1);
+    const double cx = 0.5 * (left.cols - 1), cy = 0.5 * (left.rows - 1);
+    const double corner2 = cx * cx + cy * cy;
+    for (int y = 0; y < factor.rows; ++y) {
+      auto* row = factor.ptr<float>(y);
+      for (int x = 0; x < factor.cols; ++x) {
+        const double r2 = ((x - cx) * (x - cx) + (y - cy) * (y - cy)) / corner2;
+        row[x] = static_cast<float>(gain * (1.0 - fx.vignetting * r2));
+      }
+    }
+    for (cv::Mat* image : {&left, &right}) {
+      cv::Mat value;
+      image->convertTo(value, CV_32FC1);
+      cv::multiply(value, factor, value);
+      value.convertTo(*image, CV_8UC1);  // rounds and saturates
+    }
+  }
+  if (fx.right_shift_y_px != 0.0) {
+    const cv::Matx23d shift(1, 0, 0, 0, 1, fx.right_shift_y_px);
+    cv::Mat moved;
+    cv::warpAffine(right, moved, shift, right.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    right = moved;
+  }
+  if (fx.jpeg_quality > 0) {
+    const std::vector<int> quality = {cv::IMWRITE_JPEG_QUALITY, fx.jpeg_quality};
+    for (cv::Mat* image : {&left, &right}) {
+      std::vector<std::uint8_t> bytes;
+      cv::imencode(".jpg", *image, bytes, quality);
+      *image = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+    }
+  }
+}
+
 }  // namespace
 
 namespace {
@@ -471,6 +519,7 @@ RenderedFrame Renderer::render(int index) const {
   right.edge_samples = s.edge_samples;
   render_parallel(sc, sc.eye + sc.rot * cv::Vec3d(s.camera.baseline_m, 0, 0), right, w, h);
 
+  if (s.effects.any()) apply_effects(s.effects, r.frame.time_s, r.frame.left, r.frame.right);
   r.truth = frame_truth(s, index, r.maps.ids, &r.maps.danger);
   return r;
 }

@@ -15,6 +15,7 @@
 #include "sg/core/error.hpp"
 #include "sg/core/platform.hpp"
 #include "sg/core/yaml_text.hpp"
+#include "sg/sim/random_scene.hpp"
 
 namespace sg::sim {
 namespace {
@@ -166,6 +167,33 @@ void read_camera_motion(const YamlReader& r, const YAML::Node& n, CameraMotion& 
     m.oscillation_hz = r.number(n["oscillation_hz"], "camera_motion.oscillation_hz");
 }
 
+void read_effects(const YamlReader& r, const YAML::Node& n, ImageEffects& fx) {
+  r.expect_map(n, "effects", {"exposure_steps", "vignetting", "right_shift_y_px", "jpeg_quality"});
+  if (n["vignetting"]) fx.vignetting = r.number(n["vignetting"], "effects.vignetting");
+  if (n["right_shift_y_px"])
+    fx.right_shift_y_px = r.number(n["right_shift_y_px"], "effects.right_shift_y_px");
+  if (n["jpeg_quality"]) fx.jpeg_quality = r.integer(n["jpeg_quality"], "effects.jpeg_quality");
+  if (const YAML::Node steps = n["exposure_steps"]) {
+    if (!steps.IsSequence()) r.fail(steps, "effects.exposure_steps", "expected a list");
+    fx.exposure_steps.clear();
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+      const std::string f = "effects.exposure_steps[" + std::to_string(i) + "]";
+      r.expect_map(steps[i], f, {"from_s", "gain"});
+      ExposureStep step;
+      if (steps[i]["from_s"]) step.from_s = r.number(steps[i]["from_s"], f + ".from_s");
+      if (steps[i]["gain"]) step.gain = r.number(steps[i]["gain"], f + ".gain");
+      fx.exposure_steps.push_back(step);
+    }
+  }
+}
+
+/// The scene a `random: {seed: S}` key names.
+Scenario read_random_base(const YamlReader& r, const YAML::Node& n) {
+  r.expect_map(n, "random", {"seed"});
+  if (!n["seed"]) r.fail(n, "random.seed", "missing (random: {seed: S})");
+  return random_scenario(r.seed(n["seed"], "random.seed"));
+}
+
 Box read_box(const YamlReader& r, const YAML::Node& n, const std::string& field) {
   r.expect_map(n, field,
                {"id", "size_m", "position_m", "velocity_mps", "accelerations", "texture_seed"});
@@ -196,10 +224,10 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
                {"name", "description", "frames", "camera", "height_m", "ego_velocity_mps",
                 "ego_follows_heading", "camera_motion", "platform",
                 "background_z_m", "background_height_m", "ground_seed", "background_seed",
-                "noise_sigma", "right_gain", "noise_seed", "edge_samples", "envelope",
-                "min_area_px", "obstacles"});
-  Scenario s;
-  s.name = std::filesystem::path(path).stem().string();
+                "noise_sigma", "right_gain", "noise_seed", "edge_samples", "effects", "envelope",
+                "min_area_px", "obstacles", "random"});
+  Scenario s = root["random"] ? read_random_base(r, root["random"]) : Scenario{};
+  if (!root["random"]) s.name = std::filesystem::path(path).stem().string();
   if (root["name"]) s.name = r.text(root["name"], "name");
   if (root["description"]) s.description = r.text(root["description"], "description");
   if (root["frames"]) s.frames = r.integer(root["frames"], "frames");
@@ -221,11 +249,13 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
   if (root["right_gain"]) s.right_gain = r.number(root["right_gain"], "right_gain");
   if (root["noise_seed"]) s.noise_seed = r.seed(root["noise_seed"], "noise_seed");
   if (root["edge_samples"]) s.edge_samples = r.integer(root["edge_samples"], "edge_samples");
+  if (root["effects"]) read_effects(r, root["effects"], s.effects);
   if (root["envelope"]) read_envelope(r, root["envelope"], s.envelope);
   if (root["min_area_px"]) s.min_area_px = r.integer(root["min_area_px"], "min_area_px");
   if (const YAML::Node obstacles = root["obstacles"]) {
     if (!obstacles.IsSequence() && !obstacles.IsNull())
       r.fail(obstacles, "obstacles", "expected a list of boxes");
+    s.obstacles.clear();
     for (std::size_t i = 0; i < obstacles.size(); ++i)
       s.obstacles.push_back(
           read_box(r, obstacles[i], "obstacles[" + std::to_string(i) + "]"));
@@ -332,6 +362,21 @@ std::vector<std::string> validate(const Scenario& s) {
     }
     c.require(known, "platform", s.platform, ("must be one of: " + list).c_str());
   }
+  const ImageEffects& fx = s.effects;
+  c.require(std::isfinite(fx.vignetting) && fx.vignetting >= 0 && fx.vignetting <= 0.9,
+            "effects.vignetting", fx.vignetting, "must be in 0..0.9");
+  c.require(std::isfinite(fx.right_shift_y_px) && std::abs(fx.right_shift_y_px) <= 2,
+            "effects.right_shift_y_px", fx.right_shift_y_px, "must be in -2..2");
+  c.require(fx.jpeg_quality >= 0 && fx.jpeg_quality <= 100, "effects.jpeg_quality",
+            fx.jpeg_quality, "must be in 0..100 (0 = none)");
+  for (std::size_t k = 0; k < fx.exposure_steps.size(); ++k) {
+    const ExposureStep& step = fx.exposure_steps[k];
+    const std::string f = "effects.exposure_steps[" + std::to_string(k) + "]";
+    c.require(std::isfinite(step.from_s) && step.from_s >= 0 &&
+                  (k == 0 || step.from_s > fx.exposure_steps[k - 1].from_s),
+              f + ".from_s", step.from_s, "must be >= 0 and increase from step to step");
+    c.require(std::isfinite(step.gain) && step.gain > 0, f + ".gain", step.gain, "must be > 0");
+  }
   for (const auto& e : core::validate(s.envelope)) out.push_back(e);
   std::set<int> ids;
   for (std::size_t i = 0; i < s.obstacles.size(); ++i) {
@@ -429,6 +474,21 @@ std::string to_yaml(const Scenario& s) {
   e << YAML::Key << "right_gain" << YAML::Value << to_text(s.right_gain);
   e << YAML::Key << "noise_seed" << YAML::Value << s.noise_seed;
   e << YAML::Key << "edge_samples" << YAML::Value << s.edge_samples;
+  if (s.effects.any()) {
+    e << YAML::Key << "effects" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "exposure_steps" << YAML::Value << YAML::BeginSeq;
+    for (const ExposureStep& step : s.effects.exposure_steps) {
+      e << YAML::Flow << YAML::BeginMap;
+      e << YAML::Key << "from_s" << YAML::Value << to_text(step.from_s);
+      e << YAML::Key << "gain" << YAML::Value << to_text(step.gain);
+      e << YAML::EndMap;
+    }
+    e << YAML::EndSeq;
+    e << YAML::Key << "vignetting" << YAML::Value << to_text(s.effects.vignetting);
+    e << YAML::Key << "right_shift_y_px" << YAML::Value << to_text(s.effects.right_shift_y_px);
+    e << YAML::Key << "jpeg_quality" << YAML::Value << s.effects.jpeg_quality;
+    e << YAML::EndMap;
+  }
   e << YAML::Key << "envelope" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "half_width_m" << YAML::Value << to_text(s.envelope.half_width_m);
   e << YAML::Key << "y_top_m" << YAML::Value << to_text(s.envelope.y_top_m);

@@ -191,6 +191,9 @@ TEST(Progress, LineShowsCountRateAndTimeLeft) {
   EXPECT_EQ(progress_line(10, 10, 0.5), "[####################]  10/10 frames  20.0 fps  ETA 0:00");
   EXPECT_EQ(progress_line(1, 1001, 1.0),
             "[....................]  1/1001 frames  1.0 fps  ETA 16:40");
+  // Another unit (eval --suite counts scenes): its name and "<unit>/s".
+  EXPECT_EQ(progress_line(3, 10, 6.0, "scenes"),
+            "[######..............]  3/10 scenes  0.5 scenes/s  ETA 0:14");
 }
 
 TEST(Progress, BarRedrawsInPlaceAtMostAtItsRateAndErasesItself) {

@@ -14,15 +14,17 @@ bool stderr_is_terminal();
 /// One progress line, no newline: with a known total (> 0)
 /// "[#########...........]  57/143 frames  23.4 fps  ETA 0:04", else "57 frames  23.4 fps".
 /// elapsed_s is the time since the first frame was read, s; fps and ETA are left out until it is
-/// positive.
-std::string progress_line(int done, int total, double elapsed_s);
+/// positive. Another `unit` ("scenes") replaces "frames", and its rate reads "<unit>/s".
+std::string progress_line(int done, int total, double elapsed_s,
+                          const std::string& unit = "frames");
 
 class ProgressBar {
  public:
   /// Draws on `out` (a terminal); `total` frames, or -1 when unknown. Redraws at most every
   /// `min_interval` (and always for the last frame).
   ProgressBar(std::ostream& out, int total,
-              std::chrono::milliseconds min_interval = std::chrono::milliseconds(100));
+              std::chrono::milliseconds min_interval = std::chrono::milliseconds(100),
+              std::string unit = "frames");
   /// Records one more frame done and redraws when due.
   void tick();
   /// Erases the line (before other output to the same terminal); the next tick redraws it.
@@ -38,6 +40,7 @@ class ProgressBar {
   Clock::time_point start_, last_draw_;
   int done_ = 0;
   bool drawn_ = false;
+  std::string unit_;
 };
 
 }  // namespace sg::io

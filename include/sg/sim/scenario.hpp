@@ -51,6 +51,32 @@ struct CameraMotion {
   }
 };
 
+/// From time from_s on (until the next step), every pixel of both images is multiplied by gain:
+/// an auto-exposure step. Applied after shading and noise; the ground truth does not change.
+struct ExposureStep {
+  double from_s = 0.0;  ///< start, s (steps in increasing order)
+  double gain = 1.0;    ///< > 0
+};
+
+/// Image effects of a real camera, applied to the rendered images in this order: exposure gain,
+/// vignetting, the right image's vertical shift, a JPEG round trip. The ground-truth maps stay
+/// those of the ideal pair. All defaults: none (the images are the ray caster's).
+struct ImageEffects {
+  std::vector<ExposureStep> exposure_steps;  ///< before the first step: gain 1
+  /// Brightness falls by this fraction at the image corners: gain 1 - v (r / r_corner)^2 with r
+  /// the distance to the image centre, 0..0.9; the same on both images.
+  double vignetting = 0.0;
+  /// The right image moves down by this many pixels (bilinear; a rectification error), -2..2.
+  double right_shift_y_px = 0.0;
+  /// JPEG quality of a compress-decompress round trip of each image, 1..100; 0 = none.
+  int jpeg_quality = 0;
+  /// True when any effect is set.
+  bool any() const {
+    return !exposure_steps.empty() || vignetting != 0.0 || right_shift_y_px != 0.0 ||
+           jpeg_quality != 0;
+  }
+};
+
 /// Camera-to-world rotation of the camera at time t_s (see CameraMotion).
 cv::Matx33d camera_rotation(const CameraMotion& m, double t_s);
 
@@ -91,6 +117,7 @@ struct Scenario {
   /// a thin pole's matched disparity steps instead of growing smoothly as it nears, which no
   /// camera does (docs/inputs.md, Scenarios); hence 4 x 4 by default.
   int edge_samples = 4;
+  ImageEffects effects;                   ///< exposure, vignetting, misalignment, compression
   std::vector<Box> obstacles;
   core::Envelope envelope;                ///< for the ground-truth collision test
   int min_area_px = 150;                  ///< GT alarm: a colliding obstacle covers at least this
@@ -101,7 +128,9 @@ struct Scenario {
 std::vector<std::string> builtin_scenario_names();
 /// A built-in scenario; throws core::InputError naming the known ones for an unknown name.
 Scenario builtin_scenario(const std::string& name);
-/// A scenario from a YAML (or JSON) file; unspecified fields keep the defaults above.
+/// A scenario from a YAML (or JSON) file; unspecified fields keep the defaults above. A file with
+/// `random: {seed: S}` starts from random_scenario(S) (sg/sim/random_scene.hpp) instead, and its
+/// other keys override that scene's fields (a given `obstacles` list replaces the sampled one).
 /// Throws core::InputError naming the file and the bad field.
 Scenario load_scenario_file(const std::string& path);
 /// A built-in name, or else a path to a scenario file; throws core::InputError listing the
