@@ -1,19 +1,15 @@
 #include "sg/pipeline/random_suite.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <exception>
-#include <mutex>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
-#include <thread>
 
 #include "sg/core/error.hpp"
-#include "sg/par/backend.hpp"
+#include "sg/par/jobs.hpp"
 #include "sg/pipeline/evaluation.hpp"
 #include "sg/sim/random_scene.hpp"
 #include "sg/sim/renderer.hpp"
@@ -222,34 +218,14 @@ RandomSuiteResult run_random_suite(const RandomSuiteOptions& options,
   const Clock::time_point start = Clock::now();
   RandomSuiteResult result;
   result.scenes.resize(static_cast<std::size_t>(options.count));
-  const int jobs =
-      std::min(options.count, options.jobs > 0 ? options.jobs : par::default_threads());
-  std::atomic<int> next{0};
-  std::mutex mutex;  // guards error and scene_done
-  std::exception_ptr error;
-  const auto work = [&] {
-    for (int i = next++; i < options.count; i = next++) {
-      {
-        const std::lock_guard<std::mutex> lock(mutex);
-        if (error) return;
-      }
-      try {
+  // Scenes side by side, one per thread; each scene's pipeline runs on one thread.
+  par::for_each_job(
+      options.count, options.jobs,
+      [&](int i) {
         result.scenes[static_cast<std::size_t>(i)] =
             score_random_scene(options.first_seed + static_cast<std::uint32_t>(i), options);
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(mutex);
-        if (!error) error = std::current_exception();
-        return;
-      }
-      const std::lock_guard<std::mutex> lock(mutex);
-      if (scene_done) scene_done();
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int j = 1; j < jobs; ++j) threads.emplace_back(work);
-  work();
-  for (std::thread& t : threads) t.join();
-  if (error) std::rethrow_exception(error);
+      },
+      scene_done);
   result.summary = summarise(result.scenes);
   result.summary.wall_s = seconds_since(start);
   return result;

@@ -21,6 +21,7 @@
 
 #include "sg/par/backend.hpp"
 #include "sg/par/farm.hpp"
+#include "sg/par/jobs.hpp"
 #include "sg/par/memory.hpp"
 #include "sg/par/metrics.hpp"
 #include "sg/par/tiles.hpp"
@@ -898,6 +899,46 @@ TEST(ArenaTest, LimitsConcurrencyToThreads) {
 
 // ---------------------------------------------------------------------------------------------
 // Metrics
+
+TEST(ForEachJob, RunsEveryJobOnceOnAtMostTheThreadsAsked) {
+  for (const int threads : {1, 2, 3, 0}) {
+    for (const int count : {0, 1, 2, 17}) {
+      std::vector<std::atomic<int>> runs(static_cast<size_t>(count));
+      std::atomic<int> running{0}, most{0};
+      int done = 0;  // done() is never called by two threads at once
+      par::for_each_job(
+          count, threads,
+          [&](int i) {
+            const int now = ++running;
+            int seen = most.load();
+            while (now > seen && !most.compare_exchange_weak(seen, now)) {
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(i % 3));
+            ++runs[static_cast<size_t>(i)];
+            --running;
+          },
+          [&] { ++done; });
+      for (int i = 0; i < count; ++i) EXPECT_EQ(runs[static_cast<size_t>(i)], 1) << i;
+      EXPECT_EQ(done, count);
+      EXPECT_LE(most.load(), threads > 0 ? threads : par::default_threads());
+    }
+  }
+}
+
+TEST(ForEachJob, TheFirstErrorStopsTheHandingOutAndIsRethrown) {
+  std::atomic<int> started{0};
+  int done = 0;
+  EXPECT_THROW(par::for_each_job(
+                   1000, 2,
+                   [&](int i) {
+                     ++started;
+                     if (i == 3) throw std::runtime_error("job 3");
+                   },
+                   [&] { ++done; }),
+               std::runtime_error);
+  EXPECT_LT(started.load(), 1000);
+  EXPECT_EQ(done, started.load() - 1);  // every job but the failed one reported
+}
 
 TEST(LatencyStatsTest, NearestRankPercentiles) {
   std::vector<double> values(20);
