@@ -97,7 +97,10 @@ RunOptions options_for(core::Mode mode) {
 class EveryConfiguration : public ::testing::TestWithParam<core::Mode> {};
 
 TEST_P(EveryConfiguration, GivesTheSequentialDetections) {
-  for (const Clip* clip : {&head_on(), &crossing()}) {
+  // TSan: the head-on clip only (the crossing one puts the same skeleton under the same load).
+  std::vector<const Clip*> clips{&head_on()};
+  if (!kSanitizedThreads) clips.push_back(&crossing());
+  for (const Clip* clip : clips) {
     const RunOptions reference = options_for(GetParam());
     const std::vector<std::string> expected = detections(*clip, reference);
     ASSERT_EQ(expected.size(), clip->frames.size());
