@@ -86,6 +86,18 @@ HWY_EXPORT(TestRunVectors);
 HWY_EXPORT(CurrentTarget);
 }  // namespace surface_detail
 
+namespace {
+
+/// The noise gate at a pixel of disparity disp (depth z = f B / disp): the disparity it had
+/// span_s ago at velocity V is at least min_delta_d_px below disp. The one definition both tests
+/// use; the SIMD kernel repeats its operations lane by lane.
+bool passes_noise_gate(const SurfaceTest& k, const cv::Vec3d& V, double disp, double z) {
+  const double z_before = z - V[2] * k.span_s;
+  return z_before > 0.0 && disp - k.fb / z_before >= k.min_delta_d_px;
+}
+
+}  // namespace
+
 SurfaceTest make_surface_test(const core::Camera& cam, const core::Envelope& env,
                               const core::SceneFlowParams& p, double span_s, double yaw_rate_rps) {
   SurfaceTest k;
@@ -113,9 +125,8 @@ void test_surface_run_reference(const SurfaceTest& k, const cv::Vec3d& V, double
     ttc[x] = std::numeric_limits<float>::quiet_NaN();
     const double disp = d[x];
     const double z = k.fb / disp;
+    if (!passes_noise_gate(k, V, disp, z)) continue;
     const cv::Point3d P((x - k.cx) * z / k.focal_px, (y - k.cy) * z / k.focal_px, z);
-    const double z_before = z - V[2] * k.span_s;
-    if (!(z_before > 0.0 && disp - k.fb / z_before >= k.min_delta_d_px)) continue;
     double t_c = 0.0;
     if (heads_into_envelope(P, kept, k.envelope, k.v_min_mps, t_c))
       ttc[x] = static_cast<float>(t_c * keep);  // the TTC of V itself
@@ -128,16 +139,11 @@ void test_surface_run_turning(const SurfaceTest& k, const cv::Vec3d& V, double k
   cv::Vec3d kept = V * keep;
   kept = {k.turn_cos * kept[0] - k.turn_sin * kept[2], kept[1],
           k.turn_sin * kept[0] + k.turn_cos * kept[2]};
-  if (!(kept[2] <= -k.v_min_mps) || !(V[2] < 0.0)) return;  // no pixel of the run can pass
-  // The noise gate as a least disparity: with b = -V_z span / (f B) > 0 the disparity span_s ago
-  // was d / (1 + b d), and d - d / (1 + b d) >= m  <=>  b d^2 - m b d - m >= 0.
-  const double b = -V[2] * k.span_s / k.fb, m = k.min_delta_d_px;
-  const double d_least =
-      m <= 0.0 ? 0.0 : (m * b + std::sqrt(m * m * b * b + 4.0 * m * b)) / (2.0 * b);
+  if (!(kept[2] <= -k.v_min_mps)) return;  // not approaching: no pixel of the run can pass
   for (int x = x0; x < x1; ++x) {
     const double disp = d[x];
-    if (!(disp > 0.0) || disp < d_least) continue;
     const double z = k.fb / disp;
+    if (!passes_noise_gate(k, V, disp, z)) continue;
     const cv::Point3d P((x - k.cx) * z / k.focal_px, (y - k.cy) * z / k.focal_px, z);
     double t_c = 0.0;
     if (heads_into_envelope_turning(P, kept, k.yaw_rate_rps, k.envelope, k.v_min_mps, t_c))

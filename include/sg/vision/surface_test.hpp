@@ -40,8 +40,8 @@ SurfaceTest make_surface_test(const core::Camera& cam, const core::Envelope& env
 void test_surface_run(const SurfaceTest& k, const cv::Vec3d& V, double keep, int y, int x0, int x1,
                       const float* d, float* ttc);
 
-/// test_surface_run with k.yaw_rate_rps != 0: V turned by (turn_cos, turn_sin), the noise gate as
-/// a least disparity (the same inequality solved for d), then heads_into_envelope_turning.
+/// test_surface_run with k.yaw_rate_rps != 0: V turned by (turn_cos, turn_sin), the same noise
+/// gate as the reference, then heads_into_envelope_turning.
 void test_surface_run_turning(const SurfaceTest& k, const cv::Vec3d& V, double keep, int y, int x0,
                               int x1, const float* d, float* ttc);
 
