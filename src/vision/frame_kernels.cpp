@@ -4,6 +4,7 @@
 
 #include "sg/core/error.hpp"
 #include "sg/vision/flow.hpp"
+#include "sg/vision/left_band.hpp"
 #include "sg/vision/longseq.hpp"
 #include "sg/vision/stereo_bm.hpp"
 #include "sg/vision/stereo_fast.hpp"
@@ -21,15 +22,16 @@ void check_frame(const core::StereoFrame& frame) {
 
 void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& params,
                     cv::Mat& disp, cv::Range rows) {
+  RowMatcher match = nullptr;
   switch (params.bm.matcher) {
     case core::Matcher::kBm:
-      match_bm_rows(frame.left, frame.right, params.bm, disp, rows);
+      match = match_bm_rows;
       break;
     case core::Matcher::kSgbm:
-      match_sgbm_rows(frame.left, frame.right, params.bm, disp, rows);
+      match = match_sgbm_rows;
       break;
     case core::Matcher::kFast:
-      match_fast_rows(frame.left, frame.right, params.bm, disp, rows);
+      match = match_fast_rows;
       break;
     case core::Matcher::kLongSeq: {
       LongSeqParams p;
@@ -39,9 +41,11 @@ void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& 
       p.best_max = params.bm.longseq_best_max;
       p.both_ways = params.bm.longseq_both_ways;
       longseq_disparity_rows(frame.left, frame.right, p, disp, rows);
-      break;
+      return;
     }
   }
+  match(frame.left, frame.right, params.bm, disp, rows);
+  if (params.bm.left_band) match_left_band_rows(match, frame.left, frame.right, params.bm, disp, rows);
 }
 
 void disparity_finish(const core::DetectorParams& params, cv::Mat& disp) {

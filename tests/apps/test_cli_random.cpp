@@ -71,9 +71,11 @@ TEST_F(CliRandom, SmokeSuiteWritesFiniteFigures) {
   EXPECT_EQ(s.at("scenes").get<int>(), 10);
   EXPECT_EQ(j.at("scenes").size(), 10u);
   EXPECT_EQ(s.at("colliding").get<int>() + s.at("clear").get<int>(), 10);
-  for (const char* key : {"recall_settled", "lead_s", "first_alarm_delay_s", "false_alarm_rate"})
+  for (const char* key :
+       {"recall_settled", "lead_s", "lead_entering_s", "first_alarm_delay_s", "false_alarm_rate"})
     for (const char* stat : {"mean", "p10", "p50", "p90"})
       EXPECT_TRUE(finite_number(s.at(key).at(stat))) << key << "." << stat;
+  int entering_scenes = 0;
   for (std::size_t i = 0; i < j.at("scenes").size(); ++i) {
     const nlohmann::json& scene = j.at("scenes")[i];
     EXPECT_EQ(scene.at("seed").get<long long>(), 1000 + static_cast<long long>(i));
@@ -81,7 +83,18 @@ TEST_F(CliRandom, SmokeSuiteWritesFiniteFigures) {
     EXPECT_LE(scene.at("frames").get<int>(), 40);
     EXPECT_TRUE(finite_number(scene.at("recall_settled")));
     EXPECT_TRUE(finite_number(scene.at("false_alarm_rate")));
+    // The lead over the obstacles entering the horizon in view is a minimum over a subset of
+    // those of lead_s: never below it, and only where there are such obstacles.
+    const int entering = scene.at("entering").get<int>();
+    entering_scenes += entering > 0;
+    if (!scene.at("lead_entering_s").is_null()) {
+      EXPECT_GT(entering, 0);
+      ASSERT_FALSE(scene.at("lead_s").is_null());
+      EXPECT_GE(scene.at("lead_entering_s").get<double>(), scene.at("lead_s").get<double>());
+    }
   }
+  EXPECT_EQ(s.at("lead_entering_s").at("count").get<int>() + s.at("missed_entering").get<int>(),
+            entering_scenes);
 }
 
 TEST_F(CliRandom, BadArgumentsAreOneLineAndStatus2) {

@@ -77,6 +77,11 @@ struct BmParams {
   /// range): on the shared robot recording the chessboard's period read 0.53 m for a box 0.85 m
   /// away, and the simulated ego-pass raised 3 false alarm frames, none with the check.
   int lr_max_diff = 1;
+  /// Match the left band too (vision/left_band.hpp): the columns the full range cannot search,
+  /// strip by strip with the range that fits (bm, sgbm and fast; longseq ignores it). Off: a
+  /// near point whose disparity exceeds its strip's range aliases to a wrong one
+  /// (docs/decisions/left-band.md).
+  bool left_band = false;
   // LongSeq (matcher longseq): its window is one row of block_size pixels (<= 63), its disparities
   // 0 .. num_disparities - 1 (min_disparity 0).
   double longseq_cost_max = 6.0;  ///< a good match: mean absolute difference <= this, grey levels

@@ -41,6 +41,13 @@ struct RandomSceneResult {
   /// Smallest lead over its colliding obstacles, s; nullopt when one was never warned of (or
   /// the scene is clear).
   std::optional<double> lead_s;
+  /// The same over the colliding obstacles that entered the horizon in view (their GT TTC at
+  /// their first colliding frame at least kEnteringShare of the horizon): the only ones that
+  /// can be warned of a whole horizon ahead. An obstacle that starts 1.5 s from contact bounds
+  /// lead_s by 1.5 s whatever the detector does. nullopt when one was never warned of, or the
+  /// scene has none (entering() tells).
+  std::optional<double> lead_entering_s;
+  int entering = 0;  ///< colliding obstacles that entered the horizon in view
   /// Time from the first ground-truth alarm frame (the obstacle is within the horizon and large
   /// enough) to the first alarm at or after it, s; nullopt when none followed (or clear).
   std::optional<double> first_alarm_delay_s;
@@ -49,6 +56,10 @@ struct RandomSceneResult {
   /// obstacle was never warned of; clear: the false alarm rate.
   double badness() const;
 };
+
+/// An obstacle entered the horizon in view when its first colliding frame's GT TTC is at least
+/// this share of the horizon.
+inline constexpr double kEnteringShare = 0.9;
 
 /// Mean and percentiles (nearest rank) of a sample; all 0 with count 0.
 struct Distribution {
@@ -62,6 +73,9 @@ struct RandomSuiteSummary {
   Distribution recall_settled;       ///< colliding scenes
   Distribution lead_s;               ///< colliding scenes warned of in time (missed ones apart)
   int missed = 0;                    ///< colliding scenes with an obstacle never warned of
+  /// Over the scenes with obstacles that entered the horizon in view, those warned of in time.
+  Distribution lead_entering_s;
+  int missed_entering = 0;  ///< scenes with an obstacle entering in view never warned of
   Distribution first_alarm_delay_s;  ///< colliding scenes with an alarm after the first GT alarm
   Distribution false_alarm_rate;     ///< clear scenes
   std::vector<std::uint32_t> worst_seeds;  ///< up to 10, worst first (RandomSceneResult::badness)
