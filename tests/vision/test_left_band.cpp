@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
-#include <cstring>
+#include <algorithm>
+#include <cmath>
 
 #include "sg/vision/left_band.hpp"
 #include "sg/vision/stereo_bm.hpp"
@@ -20,7 +21,8 @@ core::BmParams wide_range() {
 double share_near(const cv::Mat& disp, cv::Rect rect, float d) {
   int near = 0;
   for (int y = rect.y; y < rect.y + rect.height; ++y)
-    for (int x = rect.x; x < rect.x + rect.width; ++x) near += std::abs(disp.at<float>(y, x) - d) <= 0.5f;
+    for (int x = rect.x; x < rect.x + rect.width; ++x)
+      near += std::abs(disp.at<float>(y, x) - d) <= 0.5f;
   return static_cast<double>(near) / rect.area();
 }
 

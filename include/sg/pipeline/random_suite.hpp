@@ -45,7 +45,7 @@ struct RandomSceneResult {
   /// their first colliding frame at least kEnteringShare of the horizon): the only ones that
   /// can be warned of a whole horizon ahead. An obstacle that starts 1.5 s from contact bounds
   /// lead_s by 1.5 s whatever the detector does. nullopt when one was never warned of, or the
-  /// scene has none (entering() tells).
+  /// scene has none (`entering` tells which).
   std::optional<double> lead_entering_s;
   int entering = 0;  ///< colliding obstacles that entered the horizon in view
   /// Time from the first ground-truth alarm frame (the obstacle is within the horizon and large

@@ -18,9 +18,12 @@ using RowMatcher = void (*)(const cv::Mat& left, const cv::Mat& right, const cor
 /// Fills the left band of `rows` of disp with `match` run again, strip by strip: the 16 columns
 /// from min_disparity + n - 1 + h are matched with the range n (n = 16, 32, .. below
 /// num_disparities) on the image cut one column past the blocks that reach them (so that every
-/// prefilter reads inside the cut as in the whole image). A strip's pixels are thus a function of
-/// the pair and the strip alone, and tiles stitched are bit-identical to one call. Columns left
-/// of min_disparity + 15 + h stay invalid; disp outside the band is untouched.
+/// prefilter reads inside the cut as in the whole image). A strip's winner at its largest
+/// disparity is dropped (the true one may lie beyond the range). With lr_max_diff >= 0, each band
+/// match must also agree within lr_max_diff with the full-range match of the right pixel it
+/// points to. Every output pixel is a function of the pair alone, so tiles stitched are
+/// bit-identical to one call. Columns left of min_disparity + 15 + h stay invalid; disp right
+/// of the band is untouched.
 void match_left_band_rows(RowMatcher match, const cv::Mat& left, const cv::Mat& right,
                           const core::BmParams& p, cv::Mat& disp, cv::Range rows);
 
