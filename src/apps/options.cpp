@@ -70,7 +70,7 @@ void add_detector_options(CLI::App& app, DetectorOptions& o) {
                  "farneback");
   app.add_option("--min-area", o.min_area, "smallest obstacle blob, px (default 150)");
   app.add_option("--platform", o.platform,
-                 "detector preset of a platform: robot (default), walker or car (envelope, "
+                 "detector preset of a platform: robot (default), walker, car or drone (envelope, "
                  "disparity range, depth limits); default: the scenario's");
   app.add_option("--fps", o.fps, "pace the input like a camera at this rate, Hz (0 = no pacing)");
   app.add_option("--workers", o.workers,

@@ -40,6 +40,14 @@ const std::vector<Preset>& presets() {
                 .z_contact_m = 2.0,
                 .horizon_s = 3.0},
        128, 40.0, 60.0, 40.0, true},
+      {"drone",
+       Envelope{.half_width_m = 0.6,
+                .y_top_m = -0.4,
+                .y_bottom_m = 0.4,
+                .z_contact_m = 1.0,
+                .horizon_s = 3.0},
+       kDefaults.bm.num_disparities, 25.0, 30.0, kDefaults.scene_flow.ground.z_max_m,
+       kDefaults.scene_flow.predict_turn},
   };
   return kAll;
 }

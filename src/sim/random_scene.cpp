@@ -28,6 +28,16 @@ class Draw {
   /// -1 or +1.
   double sign() { return index(2) == 0 ? -1.0 : 1.0; }
   std::uint32_t seed() { return static_cast<std::uint32_t>(rng_()); }
+  /// A texture kind drawn with kRandomSceneRanges.texture_weights.
+  TextureKind texture() {
+    const auto& w = kRandomSceneRanges.texture_weights;
+    double u = in({0.0, 1.0});
+    for (std::size_t k = 0; k + 1 < w.size(); ++k) {
+      if (u < w[k]) return static_cast<TextureKind>(k);
+      u -= w[k];
+    }
+    return static_cast<TextureKind>(w.size() - 1);
+  }
 
  private:
   std::mt19937 rng_;
@@ -52,7 +62,8 @@ void sample_camera(Draw& d, Scenario& s, double& duration_s) {
                                                            s.camera.height / (640.0 * 480.0))));
 }
 
-void sample_motion(Draw& d, int platform, Scenario& s, RandomSceneInfo& info) {
+void sample_motion(Draw& d, int platform, double duration_s, Scenario& s,
+                   RandomSceneInfo& info) {
   const RandomSceneRanges& r = kRandomSceneRanges;
   const auto p = static_cast<std::size_t>(platform);
   s.height_m = d.in(r.height_m[p]);
@@ -67,6 +78,18 @@ void sample_motion(Draw& d, int platform, Scenario& s, RandomSceneInfo& info) {
     speed = 0.0;
   }
   s.ego_velocity_mps = cv::Vec3d(0, 0, speed);
+  if (info.ego_motion == "accelerating") {
+    const double start = speed * d.in(r.start_speed_share), ramp = d.in(r.speed_ramp_s);
+    s.ego_velocity_mps = cv::Vec3d(0, 0, start);
+    s.ego_accelerations = {{0.0, cv::Vec3d(0, 0, (speed - start) / ramp)},
+                           {ramp, cv::Vec3d(0, 0, 0)}};
+  } else if (info.ego_motion == "stopping") {
+    const double from = d.in(r.brake_start_share) * duration_s, ramp = d.in(r.brake_ramp_s);
+    s.ego_accelerations = {{from, cv::Vec3d(0, 0, -speed / ramp)},
+                           {from + ramp, cv::Vec3d(0, 0, 0)}};
+  }
+  s.camera_motion.pitch_deg = d.in(r.pitch_deg);
+  s.camera_motion.roll_deg = d.in(r.roll_deg);
   const double sway = (platform == kWalker || platform == kDrone) ? 1.0 : 1.0 / 3.0;
   s.camera_motion.pitch_amplitude_deg = sway * d.in(r.pitch_amplitude_deg);
   s.camera_motion.roll_amplitude_deg = sway * d.in(r.roll_amplitude_deg);
@@ -87,6 +110,7 @@ Box sample_obstacle(Draw& d, int platform, const Scenario& s, double duration_s,
     b.size_m[a] =
         d.in(r.shape_size_m[static_cast<std::size_t>(shape)][static_cast<std::size_t>(a)]);
   b.texture_seed = d.seed();
+  b.texture = d.texture();
   const double w = b.size_m[0], h = b.size_m[1], depth = b.size_m[2];
   double y = s.height_m - 0.5 * h;  // standing on the ground
   if (std::string(kRandomShapes[static_cast<std::size_t>(shape)]) == "bar")
@@ -135,6 +159,7 @@ void sample_sensor(Draw& d, double duration_s, Scenario& s) {
   s.right_gain = d.in(r.right_gain);
   s.noise_seed = d.seed();
   s.effects.right_shift_y_px = d.in(r.right_shift_y_px);
+  s.effects.exposure_time_s = std::min(d.in(r.exposure_time_ms) * 1e-3, 0.9 / s.camera.fps);
   s.effects.vignetting = d.in(r.vignetting);
   const int steps = d.index(r.max_exposure_steps + 1);
   std::vector<double> times;
@@ -146,6 +171,27 @@ void sample_sensor(Draw& d, double duration_s, Scenario& s) {
   }
   if (d.chance(r.jpeg_probability))
     s.effects.jpeg_quality = static_cast<int>(std::lround(d.in(r.jpeg_quality)));
+}
+
+/// Casters placed so that their shadows start on the ground in view and drift.
+void sample_shadows(Draw& d, Scenario& s) {
+  const RandomSceneRanges& r = kRandomSceneRanges;
+  if (!d.chance(r.shadow_probability)) return;
+  const double elevation = d.in(r.sun_elevation_deg) * kDeg, azimuth = d.in({0.0, 360.0}) * kDeg;
+  s.shadows.to_light = cv::Vec3d(std::cos(elevation) * std::sin(azimuth), -std::sin(elevation),
+                                 std::cos(elevation) * std::cos(azimuth));
+  const int count = 1 + d.index(r.max_shadow_casters);
+  for (int i = 0; i < count; ++i) {
+    ShadowCaster c;
+    const cv::Vec3d ground(d.in(r.shadow_side_m), s.height_m, d.in(r.shadow_ahead_m));
+    const double up = d.in(r.caster_height_m);
+    c.position_m = ground + s.shadows.to_light * (up / std::sin(elevation));
+    const double speed = d.in(r.caster_speed_mps), heading = d.in({0.0, 360.0}) * kDeg;
+    c.velocity_mps = cv::Vec3d(speed * std::sin(heading), 0, speed * std::cos(heading));
+    c.radius_m = d.in(r.caster_radius_m);
+    c.darkness = d.in(r.shadow_darkness);
+    s.shadows.casters.push_back(c);
+  }
 }
 
 std::string describe(const Scenario& s, const RandomSceneInfo& info) {
@@ -170,11 +216,11 @@ Scenario random_scenario(std::uint32_t seed, RandomSceneInfo* info_out) {
   s.name = "random-" + std::to_string(seed);
   const int platform = d.index(static_cast<int>(kRandomPlatforms.size()));
   info.platform = kRandomPlatforms[static_cast<std::size_t>(platform)];
-  s.platform = platform == kDrone ? "robot" : info.platform;
+  s.platform = info.platform;
   s.envelope = core::platform_envelope(s.platform);
   double duration_s = 0.0;
   sample_camera(d, s, duration_s);
-  sample_motion(d, platform, s, info);
+  sample_motion(d, platform, duration_s, s, info);
   s.ground_seed = d.seed();
   s.background_seed = d.seed();
   const int count = d.index(r.max_obstacles + 1);
@@ -189,6 +235,9 @@ Scenario random_scenario(std::uint32_t seed, RandomSceneInfo* info_out) {
   s.background_z_m =
       std::max({d.in(r.background_z_m), far_z + 5.0, s.ego_velocity_mps[2] * duration_s + 10.0});
   sample_sensor(d, duration_s, s);
+  s.ground_texture = d.texture();
+  s.background_texture = d.texture();
+  sample_shadows(d, s);
   s.description = describe(s, info);
   if (info_out) *info_out = info;
   return s;

@@ -29,7 +29,14 @@ struct BoxNow {
   cv::Vec3d shift_prev;  // centre one frame earlier minus centre now, m
   int id = 0;
   std::uint32_t seed = 0;
+  int texture = 0;  // TextureKind as an index
   double albedo = 0.0;
+};
+
+/// A shadow caster at the frame time.
+struct CasterNow {
+  cv::Vec3d centre;
+  double radius = 0.0, darkness = 0.0;
 };
 
 /// Everything the ray caster needs for one frame.
@@ -41,8 +48,11 @@ struct Scene {
   cv::Matx33d rot_prev = cv::Matx33d::eye();  // ... one frame earlier
   double ground_y = 0, wall_z = 0, wall_top_y = 0;
   std::uint32_t ground_seed = 0, wall_seed = 0;
+  int ground_texture = 0, wall_texture = 0;  // TextureKind as an index
   double ground_albedo = 0, wall_albedo = 0;
   std::vector<BoxNow> boxes;
+  cv::Vec3d to_light;  // unit
+  std::vector<CasterNow> casters;
 };
 
 struct Hit {
@@ -73,6 +83,8 @@ Scene make_scene(const Scenario& s, int index) {
   sc.wall_top_y = s.height_m - s.background_height_m;
   sc.ground_seed = s.ground_seed;
   sc.wall_seed = s.background_seed;
+  sc.ground_texture = static_cast<int>(s.ground_texture);
+  sc.wall_texture = static_cast<int>(s.background_texture);
   sc.ground_albedo = albedo_of(s.ground_seed);
   sc.wall_albedo = albedo_of(s.background_seed);
   for (const Box& b : s.obstacles) {
@@ -83,9 +95,13 @@ Scene make_scene(const Scenario& s, int index) {
     n.shift_prev = box_position(b, t - sc.dt) - n.centre;
     n.id = b.id;
     n.seed = b.texture_seed;
+    n.texture = static_cast<int>(b.texture);
     n.albedo = albedo_of(b.texture_seed);
     sc.boxes.push_back(n);
   }
+  sc.to_light = cv::normalize(s.shadows.to_light);
+  for (const ShadowCaster& c : s.shadows.casters)
+    sc.casters.push_back({c.position_m + c.velocity_mps * t, c.radius_m, c.darkness});
   return sc;
 }
 
@@ -160,18 +176,36 @@ double footprint(const Scene& sc, int axis, double depth, const cv::Vec3d& dir, 
   return depth / sc.f * std::max(fu, fv);
 }
 
+/// Share of the light reaching surface point p: 1 - darkness inside a caster's umbra, 1 outside
+/// its penumbra (0.85..1.15 of its radius from the ray towards the light), smooth between.
+double lit(const Scene& sc, const cv::Vec3d& p) {
+  double light = 1.0;
+  for (const CasterNow& c : sc.casters) {
+    const cv::Vec3d w = c.centre - p;
+    const double along = w.dot(sc.to_light);
+    if (along <= 0.0) continue;  // the caster is not between p and the light
+    const double dist = std::sqrt(std::max(0.0, w.dot(w) - along * along));
+    const double inside = 1.0 - smoothstep01((dist / c.radius - 0.85) / 0.3);
+    light *= 1.0 - c.darkness * inside;
+  }
+  return light;
+}
+
 /// Gray level (before noise and gain) of the surface hit by the ray from o.
 double shade(const Scene& sc, const Hit& hit, const cv::Vec3d& o, const cv::Vec3d& dir) {
   if (hit.surface == Surface::kSky) return kSkyGray;
   const cv::Vec3d p = o + dir * hit.depth;
+  const double light = sc.casters.empty() ? 1.0 : lit(sc, p);
   if (hit.surface == Surface::kGround) {
     const double fp = footprint(sc, 1, hit.depth, dir, 0, 2, 1.0, kGroundStretchZ);
-    return sc.ground_albedo +
-           kContrast * texture_value(p[0], p[2] / kGroundStretchZ, sc.ground_seed, fp);
+    return light * (sc.ground_albedo + kContrast * pattern_value(sc.ground_texture, p[0],
+                                                                 p[2] / kGroundStretchZ,
+                                                                 sc.ground_seed, fp));
   }
   if (hit.surface == Surface::kWall) {
     const double fp = footprint(sc, 2, hit.depth, dir, 0, 1, 1.0, 1.0);
-    return sc.wall_albedo + kContrast * texture_value(p[0], p[1], sc.wall_seed, fp);
+    return light * (sc.wall_albedo +
+                    kContrast * pattern_value(sc.wall_texture, p[0], p[1], sc.wall_seed, fp));
   }
   const BoxNow& b = sc.boxes[static_cast<std::size_t>(hit.box)];
   const cv::Vec3d local = p - b.centre;
@@ -182,8 +216,9 @@ double shade(const Scene& sc, const Hit& hit, const cv::Vec3d& o, const cv::Vec3
   const int u = kU[hit.axis], v = kV[hit.axis];
   const double fp = footprint(sc, hit.axis, hit.depth, dir, u, v, 1.0, 1.0);
   const auto face = static_cast<std::uint32_t>(hit.axis * 2 + hit.side);
-  return b.albedo * kFaceShade[hit.axis] +
-         kContrast * texture_value(local[u], local[v], hash_combine(b.seed, face), fp);
+  return light * (b.albedo * kFaceShade[hit.axis] +
+                   kContrast * pattern_value(b.texture, local[u], local[v],
+                                             hash_combine(b.seed, face), fp));
 }
 
 /// Identity of the surface a ray hit (sky, ground, wall, or one face of one box): where it
@@ -210,8 +245,8 @@ struct RowTargets {
 /// Renders rows [rows.start, rows.end) of the camera at `eye` with one ray through each pixel's
 /// centre; for the gray image only its shade and surface (integrate_rows finishes it). Each pixel
 /// depends only on its own ray, so any split into row ranges gives the same images.
-void render_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, cv::Range rows,
-                 int width) {
+void render_rows(const Scene& sc, const cv::Vec3d& eye, const cv::Vec3d& eye_prev,
+                 const RowTargets& out, cv::Range rows, int width) {
   for (int y = rows.start; y < rows.end; ++y) {
     const double dy = (y - sc.cy) / sc.f;
     auto* shade_row = out.shade ? out.shade->ptr<float>(y) : nullptr;
@@ -247,7 +282,7 @@ void render_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out, c
           // The same surface point one frame earlier, seen from the camera one frame earlier.
           cv::Vec3d p = eye + dir * hit.depth;
           if (is_box) p += sc.boxes[hit.box].shift_prev;
-          const cv::Vec3d rel = sc.rot_prev.t() * (p - sc.eye_prev);
+          const cv::Vec3d rel = sc.rot_prev.t() * (p - eye_prev);
           if (rel[2] > kMinHitDepth) {
             q[0] = static_cast<float>(sc.cx + sc.f * rel[0] / rel[2] - x);
             q[1] = static_cast<float>(sc.cy + sc.f * rel[1] / rel[2] - y);
@@ -297,8 +332,9 @@ void integrate_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out
   }
 }
 
-void render_parallel(const Scene& sc, const cv::Vec3d& eye, RowTargets out, int width,
-                     int height) {
+/// Renders the camera at `eye` (one frame earlier at `eye_prev`, for the flow).
+void render_parallel(const Scene& sc, const cv::Vec3d& eye, const cv::Vec3d& eye_prev,
+                     RowTargets out, int width, int height) {
   cv::Mat shade, code;
   if (out.gray) {
     shade.create(height, width, CV_32FC1);
@@ -307,7 +343,7 @@ void render_parallel(const Scene& sc, const cv::Vec3d& eye, RowTargets out, int 
     out.code = &code;
   }
   cv::parallel_for_(cv::Range(0, height),
-                    [&](const cv::Range& r) { render_rows(sc, eye, out, r, width); });
+                    [&](const cv::Range& r) { render_rows(sc, eye, eye_prev, out, r, width); });
   if (out.gray)
     cv::parallel_for_(cv::Range(0, height),
                       [&](const cv::Range& r) { integrate_rows(sc, eye, out, r); });
@@ -398,6 +434,36 @@ void apply_effects(const ImageEffects& fx, double t_s, cv::Mat& left, cv::Mat& r
   }
 }
 
+/// The exposure's blur and the sensor noise for one image rendered without noise: the mean of
+/// `gray` sampled at p + flow(p) * share * (1/2 - k / (n - 1)), k = 0..n-1, with flow the
+/// backward flow of one frame and share the exposure over the frame interval, then `noise`.
+void blur_and_add_noise(cv::Mat& gray, const cv::Mat& flow, double share, const cv::Mat& noise) {
+  double longest = 0.0;
+  for (int y = 0; y < flow.rows; ++y) {
+    const auto* q = flow.ptr<cv::Vec2f>(y);
+    for (int x = 0; x < flow.cols; ++x)
+      longest = std::max(longest, std::hypot(static_cast<double>(q[x][0]), q[x][1]));
+  }
+  const int n = std::clamp(static_cast<int>(std::ceil(longest * share)) + 1, 2, 12);
+  cv::Mat source, sum = cv::Mat::zeros(gray.size(), CV_32FC1), sample;
+  gray.convertTo(source, CV_32FC1);
+  cv::Mat map(gray.size(), CV_32FC2);
+  for (int k = 0; k < n; ++k) {
+    const double c = share * (0.5 - static_cast<double>(k) / (n - 1));
+    for (int y = 0; y < map.rows; ++y) {
+      const auto* q = flow.ptr<cv::Vec2f>(y);
+      auto* m = map.ptr<cv::Vec2f>(y);
+      for (int x = 0; x < map.cols; ++x)
+        m[x] = cv::Vec2f(static_cast<float>(x + c * q[x][0]), static_cast<float>(y + c * q[x][1]));
+    }
+    cv::remap(source, sample, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    sum += sample;
+  }
+  sum *= 1.0 / n;
+  if (!noise.empty()) sum += noise;
+  sum.convertTo(gray, CV_8UC1);  // rounds and saturates
+}
+
 }  // namespace
 
 namespace {
@@ -412,10 +478,28 @@ core::ObstacleTruth turning_collision(const Scenario& s, const Box& box, double 
   const cv::Vec3d centre = box_position(box, t_s), velocity = box_velocity(box, t_s);
   const cv::Vec3d half = box.size_m * 0.5;
   const int steps = static_cast<int>(std::ceil(e.horizon_s / kStep));
+  const bool steady = s.ego_accelerations.empty();
+  const cv::Vec3d eye_now = ego_position(s, t_s);
+  Scenario coasting;  // the camera from t_s on at its velocity then, for the path ahead
+  if (!steady) {
+    coasting.ego_velocity_mps = ego_heading_velocity(s, t_s);
+    coasting.ego_follows_heading = s.ego_follows_heading;
+    coasting.camera_motion.yaw_rate_dps = s.camera_motion.yaw_rate_dps;
+  }
+  const double w = s.camera_motion.yaw_rate_dps * CV_PI / 180.0;
+  const auto steady_path = [&](double tau) {
+    // The heading at t_s turns the coasting path, which starts at heading 0.
+    const cv::Vec3d d = ego_position(coasting, tau);
+    if (!s.ego_follows_heading || w == 0.0) return d;
+    const double c = std::cos(w * t_s), sn = std::sin(w * t_s);
+    return cv::Vec3d(c * d[0] + sn * d[2], d[1], -sn * d[0] + c * d[2]);
+  };
   for (int i = 0; i <= steps; ++i) {
     const double tau = std::min(i * kStep, e.horizon_s);
     const cv::Matx33d to_camera = camera_rotation(s.camera_motion, t_s + tau).t();
-    const cv::Vec3d eye = ego_position(s, t_s + tau);
+    // The camera on its path at its current speed (ego accelerations are not foreseen, as the
+    // box's are not).
+    const cv::Vec3d eye = steady ? ego_position(s, t_s + tau) : eye_now + steady_path(tau);
     const cv::Vec3d c = centre + velocity * tau;
     cv::Vec3d lo(kInf, kInf, kInf), hi(-kInf, -kInf, -kInf);
     for (int k = 0; k < 8; ++k) {
@@ -445,8 +529,8 @@ core::ObstacleTruth box_collision(const Scenario& s, const Box& box, double t_s)
   core::ObstacleTruth o;
   o.id = box.id;
   const core::Envelope& e = s.envelope;
-  const cv::Vec3d rel = box_position(box, t_s) - s.ego_velocity_mps * t_s;
-  const cv::Vec3d v = box_velocity(box, t_s) - s.ego_velocity_mps;
+  const cv::Vec3d rel = box_position(box, t_s) - ego_position(s, t_s);
+  const cv::Vec3d v = box_velocity(box, t_s) - ego_velocity(s, t_s);
   const cv::Vec3d half = box.size_m * 0.5;
   const auto overlaps_at = [&](double dt) {
     const cv::Vec3d c = rel + v * dt;
@@ -490,6 +574,13 @@ RenderedFrame Renderer::render(int index) const {
   r.maps.disparity.create(h, w, CV_32FC1);
   r.maps.ids.create(h, w, CV_16UC1);
   if (index > 0) r.maps.flow.create(h, w, CV_32FC2);
+  // Motion blur needs each camera's own image motion, frame 0's too.
+  const bool blur = s.effects.exposure_time_s > 0.0;
+  cv::Mat left_flow = index > 0 ? r.maps.flow : cv::Mat(), right_flow;
+  if (blur) {
+    if (left_flow.empty()) left_flow.create(h, w, CV_32FC2);
+    right_flow.create(h, w, CV_32FC2);
+  }
 
   // Noise is drawn serially from one generator per (seed, frame, side): thread-count independent.
   cv::Mat noise[2];
@@ -505,19 +596,27 @@ RenderedFrame Renderer::render(int index) const {
 
   RowTargets left;
   left.gray = &r.frame.left;
-  left.noise = noise[0].empty() ? nullptr : &noise[0];
+  left.noise = noise[0].empty() || blur ? nullptr : &noise[0];
   left.edge_samples = s.edge_samples;
   left.disparity = &r.maps.disparity;
-  left.flow = index > 0 ? &r.maps.flow : nullptr;
+  left.flow = left_flow.empty() ? nullptr : &left_flow;
   left.ids = &r.maps.ids;
-  render_parallel(sc, sc.eye, left, w, h);
+  render_parallel(sc, sc.eye, sc.eye_prev, left, w, h);
 
   RowTargets right;
   right.gray = &r.frame.right;
-  right.noise = noise[1].empty() ? nullptr : &noise[1];
+  right.noise = noise[1].empty() || blur ? nullptr : &noise[1];
   right.gain = s.right_gain;
   right.edge_samples = s.edge_samples;
-  render_parallel(sc, sc.eye + sc.rot * cv::Vec3d(s.camera.baseline_m, 0, 0), right, w, h);
+  right.flow = blur ? &right_flow : nullptr;
+  const cv::Vec3d baseline(s.camera.baseline_m, 0, 0);
+  render_parallel(sc, sc.eye + sc.rot * baseline, sc.eye_prev + sc.rot_prev * baseline, right, w,
+                  h);
+  if (blur) {
+    const double share = s.effects.exposure_time_s * s.camera.fps;
+    blur_and_add_noise(r.frame.left, left_flow, share, noise[0]);
+    blur_and_add_noise(r.frame.right, right_flow, share, noise[1]);
+  }
 
   if (s.effects.any()) apply_effects(s.effects, r.frame.time_s, r.frame.left, r.frame.right);
   r.truth = frame_truth(s, index, r.maps.ids, &r.maps.danger);
@@ -530,7 +629,7 @@ core::FrameTruth Renderer::truth(int index) const {
   cv::Mat ids(scenario_.camera.height, scenario_.camera.width, CV_16UC1);
   RowTargets out;
   out.ids = &ids;
-  render_parallel(sc, sc.eye, out, ids.cols, ids.rows);
+  render_parallel(sc, sc.eye, sc.eye_prev, out, ids.cols, ids.rows);
   return frame_truth(scenario_, index, ids, nullptr);
 }
 

@@ -157,8 +157,11 @@ void read_envelope(const YamlReader& r, const YAML::Node& n, core::Envelope& e) 
 
 void read_camera_motion(const YamlReader& r, const YAML::Node& n, CameraMotion& m) {
   r.expect_map(n, "camera_motion",
-               {"yaw_rate_dps", "pitch_amplitude_deg", "roll_amplitude_deg", "oscillation_hz"});
+               {"yaw_rate_dps", "pitch_deg", "roll_deg", "pitch_amplitude_deg",
+                "roll_amplitude_deg", "oscillation_hz"});
   if (n["yaw_rate_dps"]) m.yaw_rate_dps = r.number(n["yaw_rate_dps"], "camera_motion.yaw_rate_dps");
+  if (n["pitch_deg"]) m.pitch_deg = r.number(n["pitch_deg"], "camera_motion.pitch_deg");
+  if (n["roll_deg"]) m.roll_deg = r.number(n["roll_deg"], "camera_motion.roll_deg");
   if (n["pitch_amplitude_deg"])
     m.pitch_amplitude_deg = r.number(n["pitch_amplitude_deg"], "camera_motion.pitch_amplitude_deg");
   if (n["roll_amplitude_deg"])
@@ -168,7 +171,11 @@ void read_camera_motion(const YamlReader& r, const YAML::Node& n, CameraMotion& 
 }
 
 void read_effects(const YamlReader& r, const YAML::Node& n, ImageEffects& fx) {
-  r.expect_map(n, "effects", {"exposure_steps", "vignetting", "right_shift_y_px", "jpeg_quality"});
+  r.expect_map(n, "effects",
+               {"exposure_steps", "vignetting", "right_shift_y_px", "jpeg_quality",
+                "exposure_time_s"});
+  if (n["exposure_time_s"])
+    fx.exposure_time_s = r.number(n["exposure_time_s"], "effects.exposure_time_s");
   if (n["vignetting"]) fx.vignetting = r.number(n["vignetting"], "effects.vignetting");
   if (n["right_shift_y_px"])
     fx.right_shift_y_px = r.number(n["right_shift_y_px"], "effects.right_shift_y_px");
@@ -187,6 +194,51 @@ void read_effects(const YamlReader& r, const YAML::Node& n, ImageEffects& fx) {
   }
 }
 
+std::vector<AccelerationPhase> read_phases(const YamlReader& r, const YAML::Node& phases,
+                                           const std::string& field) {
+  if (!phases.IsSequence()) r.fail(phases, field, "expected a list");
+  std::vector<AccelerationPhase> out;
+  for (std::size_t i = 0; i < phases.size(); ++i) {
+    const std::string f = field + "[" + std::to_string(i) + "]";
+    r.expect_map(phases[i], f, {"from_s", "acceleration_mps2"});
+    AccelerationPhase ph;
+    if (phases[i]["from_s"]) ph.from_s = r.number(phases[i]["from_s"], f + ".from_s");
+    if (phases[i]["acceleration_mps2"])
+      ph.acceleration_mps2 = r.vec3(phases[i]["acceleration_mps2"], f + ".acceleration_mps2");
+    out.push_back(ph);
+  }
+  return out;
+}
+
+TextureKind read_texture(const YamlReader& r, const YAML::Node& n, const std::string& field) {
+  const std::string name = r.text(n, field);
+  try {
+    return texture_kind(name);
+  } catch (const core::InputError& e) {
+    r.fail(n, field, e.what());
+  }
+}
+
+void read_shadows(const YamlReader& r, const YAML::Node& n, Shadows& sh) {
+  r.expect_map(n, "shadows", {"to_light", "casters"});
+  if (n["to_light"]) sh.to_light = r.vec3(n["to_light"], "shadows.to_light");
+  if (const YAML::Node casters = n["casters"]) {
+    if (!casters.IsSequence()) r.fail(casters, "shadows.casters", "expected a list");
+    sh.casters.clear();
+    for (std::size_t i = 0; i < casters.size(); ++i) {
+      const std::string f = "shadows.casters[" + std::to_string(i) + "]";
+      const YAML::Node c = casters[i];
+      r.expect_map(c, f, {"position_m", "velocity_mps", "radius_m", "darkness"});
+      ShadowCaster caster;
+      if (c["position_m"]) caster.position_m = r.vec3(c["position_m"], f + ".position_m");
+      if (c["velocity_mps"]) caster.velocity_mps = r.vec3(c["velocity_mps"], f + ".velocity_mps");
+      if (c["radius_m"]) caster.radius_m = r.number(c["radius_m"], f + ".radius_m");
+      if (c["darkness"]) caster.darkness = r.number(c["darkness"], f + ".darkness");
+      sh.casters.push_back(caster);
+    }
+  }
+}
+
 /// The scene a `random: {seed: S}` key names.
 Scenario read_random_base(const YamlReader& r, const YAML::Node& n) {
   r.expect_map(n, "random", {"seed"});
@@ -196,25 +248,17 @@ Scenario read_random_base(const YamlReader& r, const YAML::Node& n) {
 
 Box read_box(const YamlReader& r, const YAML::Node& n, const std::string& field) {
   r.expect_map(n, field,
-               {"id", "size_m", "position_m", "velocity_mps", "accelerations", "texture_seed"});
+               {"id", "size_m", "position_m", "velocity_mps", "accelerations", "texture_seed",
+                "texture"});
   Box b;
   if (n["id"]) b.id = r.integer(n["id"], field + ".id");
   if (n["size_m"]) b.size_m = r.vec3(n["size_m"], field + ".size_m");
   if (n["position_m"]) b.position_m = r.vec3(n["position_m"], field + ".position_m");
   if (n["velocity_mps"]) b.velocity_mps = r.vec3(n["velocity_mps"], field + ".velocity_mps");
   if (n["texture_seed"]) b.texture_seed = r.seed(n["texture_seed"], field + ".texture_seed");
-  if (const YAML::Node phases = n["accelerations"]) {
-    if (!phases.IsSequence()) r.fail(phases, field + ".accelerations", "expected a list");
-    for (std::size_t i = 0; i < phases.size(); ++i) {
-      const std::string f = field + ".accelerations[" + std::to_string(i) + "]";
-      r.expect_map(phases[i], f, {"from_s", "acceleration_mps2"});
-      AccelerationPhase ph;
-      if (phases[i]["from_s"]) ph.from_s = r.number(phases[i]["from_s"], f + ".from_s");
-      if (phases[i]["acceleration_mps2"])
-        ph.acceleration_mps2 = r.vec3(phases[i]["acceleration_mps2"], f + ".acceleration_mps2");
-      b.accelerations.push_back(ph);
-    }
-  }
+  if (n["texture"]) b.texture = read_texture(r, n["texture"], field + ".texture");
+  if (n["accelerations"])
+    b.accelerations = read_phases(r, n["accelerations"], field + ".accelerations");
   return b;
 }
 
@@ -222,8 +266,9 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
   if (root.IsNull()) r.fail(root, "(document)", "the file is empty");
   r.expect_map(root, "",
                {"name", "description", "frames", "camera", "height_m", "ego_velocity_mps",
-                "ego_follows_heading", "camera_motion", "platform",
+                "ego_follows_heading", "ego_accelerations", "camera_motion", "platform",
                 "background_z_m", "background_height_m", "ground_seed", "background_seed",
+                "ground_texture", "background_texture", "shadows",
                 "noise_sigma", "right_gain", "noise_seed", "edge_samples", "effects", "envelope",
                 "min_area_px", "obstacles", "random"});
   Scenario s = root["random"] ? read_random_base(r, root["random"]) : Scenario{};
@@ -237,6 +282,8 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
     s.ego_velocity_mps = r.vec3(root["ego_velocity_mps"], "ego_velocity_mps");
   if (root["ego_follows_heading"])
     s.ego_follows_heading = r.boolean(root["ego_follows_heading"], "ego_follows_heading");
+  if (root["ego_accelerations"])
+    s.ego_accelerations = read_phases(r, root["ego_accelerations"], "ego_accelerations");
   if (root["camera_motion"]) read_camera_motion(r, root["camera_motion"], s.camera_motion);
   if (root["platform"]) s.platform = r.text(root["platform"], "platform");
   if (root["background_z_m"]) s.background_z_m = r.number(root["background_z_m"], "background_z_m");
@@ -245,6 +292,11 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
   if (root["ground_seed"]) s.ground_seed = r.seed(root["ground_seed"], "ground_seed");
   if (root["background_seed"])
     s.background_seed = r.seed(root["background_seed"], "background_seed");
+  if (root["ground_texture"])
+    s.ground_texture = read_texture(r, root["ground_texture"], "ground_texture");
+  if (root["background_texture"])
+    s.background_texture = read_texture(r, root["background_texture"], "background_texture");
+  if (root["shadows"]) read_shadows(r, root["shadows"], s.shadows);
   if (root["noise_sigma"]) s.noise_sigma = r.number(root["noise_sigma"], "noise_sigma");
   if (root["right_gain"]) s.right_gain = r.number(root["right_gain"], "right_gain");
   if (root["noise_seed"]) s.noise_seed = r.seed(root["noise_seed"], "noise_seed");
@@ -265,19 +317,21 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
 
 }  // namespace
 
-cv::Vec3d box_position(const Box& box, double t_s) {
-  cv::Vec3d p = box.position_m, v = box.velocity_mps;
+namespace {
+
+/// Position and velocity after moving from (p, v) at time 0 to time t_s under `phases`
+/// (piecewise-constant acceleration, none before the first phase).
+void integrate_phases(const std::vector<AccelerationPhase>& phases, double t_s, cv::Vec3d& p,
+                      cv::Vec3d& v) {
   double t = 0.0;  // p, v hold the state at time t
-  for (std::size_t i = 0; i < box.accelerations.size(); ++i) {
-    const AccelerationPhase& ph = box.accelerations[i];
+  for (std::size_t i = 0; i < phases.size(); ++i) {
+    const AccelerationPhase& ph = phases[i];
     if (ph.from_s >= t_s) break;
     if (ph.from_s > t) {  // coast from t to the phase start (no acceleration before phase 0)
       p += v * (ph.from_s - t);
       t = ph.from_s;
     }
-    const double end = i + 1 < box.accelerations.size()
-                           ? std::min(t_s, box.accelerations[i + 1].from_s)
-                           : t_s;
+    const double end = i + 1 < phases.size() ? std::min(t_s, phases[i + 1].from_s) : t_s;
     const double span = end - t;
     if (span > 0) {
       p += v * span + ph.acceleration_mps2 * (0.5 * span * span);
@@ -285,19 +339,49 @@ cv::Vec3d box_position(const Box& box, double t_s) {
       t = end;
     }
   }
-  return p + v * (t_s - t);
+  p += v * (t_s - t);
+}
+
+/// The integral over [a, b] of R_y(w tau) (u + k (tau - a)) d tau, w != 0 (R_y as in
+/// camera_rotation: it turns +Z towards +X), in closed form.
+cv::Vec3d turned_integral(double w, const cv::Vec3d& u, const cv::Vec3d& k, double a, double b) {
+  const double sa = std::sin(w * a), sb = std::sin(w * b);
+  const double ca = std::cos(w * a), cb = std::cos(w * b);
+  const double span = b - a;
+  const double c0 = (sb - sa) / w, s0 = (ca - cb) / w;  // integrals of cos, sin
+  const double c1 = span * sb / w + (cb - ca) / (w * w);   // of (tau - a) cos
+  const double s1 = -span * cb / w + (sb - sa) / (w * w);  // of (tau - a) sin
+  return {u[0] * c0 + u[2] * s0 + k[0] * c1 + k[2] * s1, u[1] * span + k[1] * 0.5 * span * span,
+          -u[0] * s0 + u[2] * c0 - k[0] * s1 + k[2] * c1};
+}
+
+double yaw_rate_rad(const Scenario& s) { return s.camera_motion.yaw_rate_dps * CV_PI / 180.0; }
+
+}  // namespace
+
+const std::vector<std::string>& texture_kind_names() {
+  static const std::vector<std::string> kNames = {"noise", "low", "tiles", "stripes", "clutter"};
+  return kNames;
+}
+
+TextureKind texture_kind(const std::string& name) {
+  const auto& names = texture_kind_names();
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<TextureKind>(i);
+  std::string list;
+  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+  throw core::InputError("unknown texture '" + name + "' (known: " + list + ")");
+}
+
+cv::Vec3d box_position(const Box& box, double t_s) {
+  cv::Vec3d p = box.position_m, v = box.velocity_mps;
+  integrate_phases(box.accelerations, t_s, p, v);
+  return p;
 }
 
 cv::Vec3d box_velocity(const Box& box, double t_s) {
-  cv::Vec3d v = box.velocity_mps;
-  for (std::size_t i = 0; i < box.accelerations.size(); ++i) {
-    const AccelerationPhase& ph = box.accelerations[i];
-    if (ph.from_s >= t_s) break;
-    const double end = i + 1 < box.accelerations.size()
-                           ? std::min(t_s, box.accelerations[i + 1].from_s)
-                           : t_s;
-    if (end > ph.from_s) v += ph.acceleration_mps2 * (end - ph.from_s);
-  }
+  cv::Vec3d p = box.position_m, v = box.velocity_mps;
+  integrate_phases(box.accelerations, t_s, p, v);
   return v;
 }
 
@@ -305,8 +389,8 @@ cv::Matx33d camera_rotation(const CameraMotion& m, double t_s) {
   constexpr double kDeg = CV_PI / 180.0;
   const double phase = 2.0 * CV_PI * m.oscillation_hz * t_s;
   const double yaw = m.yaw_rate_dps * kDeg * t_s;
-  const double pitch = m.pitch_amplitude_deg * kDeg * std::sin(phase);
-  const double roll = m.roll_amplitude_deg * kDeg * std::cos(phase);
+  const double pitch = (m.pitch_deg + m.pitch_amplitude_deg * std::sin(phase)) * kDeg;
+  const double roll = (m.roll_deg + m.roll_amplitude_deg * std::cos(phase)) * kDeg;
   const double cy = std::cos(yaw), sy = std::sin(yaw);
   const double cp = std::cos(pitch), sp = std::sin(pitch);
   const double cr = std::cos(roll), sr = std::sin(roll);
@@ -317,13 +401,45 @@ cv::Matx33d camera_rotation(const CameraMotion& m, double t_s) {
   return ry * rx * rz;
 }
 
+cv::Vec3d ego_heading_velocity(const Scenario& s, double t_s) {
+  cv::Vec3d p(0, 0, 0), v = s.ego_velocity_mps;
+  integrate_phases(s.ego_accelerations, t_s, p, v);
+  return v;
+}
+
+cv::Vec3d ego_velocity(const Scenario& s, double t_s) {
+  const cv::Vec3d v = ego_heading_velocity(s, t_s);
+  const double w = yaw_rate_rad(s);
+  if (!s.ego_follows_heading || w == 0.0) return v;
+  const double c = std::cos(w * t_s), sn = std::sin(w * t_s);
+  return {c * v[0] + sn * v[2], v[1], -sn * v[0] + c * v[2]};
+}
+
 cv::Vec3d ego_position(const Scenario& s, double t_s) {
-  const cv::Vec3d& v = s.ego_velocity_mps;
-  const double w = s.camera_motion.yaw_rate_dps * CV_PI / 180.0;  // rad/s
-  if (!s.ego_follows_heading || w == 0.0) return v * t_s;
-  // The integral of R_y(w tau) v over [0, t]: R_y turns +Z towards +X (camera_rotation).
-  const double sin_part = std::sin(w * t_s) / w, cos_part = (1.0 - std::cos(w * t_s)) / w;
-  return {v[0] * sin_part + v[2] * cos_part, v[1] * t_s, v[2] * sin_part - v[0] * cos_part};
+  const double w = yaw_rate_rad(s);
+  if (!s.ego_follows_heading || w == 0.0) {
+    cv::Vec3d p(0, 0, 0), v = s.ego_velocity_mps;
+    integrate_phases(s.ego_accelerations, t_s, p, v);
+    return p;
+  }
+  // Phase by phase: within one the heading-frame velocity is linear in time.
+  const cv::Vec3d none(0, 0, 0);
+  cv::Vec3d p(0, 0, 0), v = s.ego_velocity_mps;
+  double t = 0.0;
+  const auto& phases = s.ego_accelerations;
+  for (std::size_t i = 0; i < phases.size() && phases[i].from_s < t_s; ++i) {
+    if (phases[i].from_s > t) {
+      p += turned_integral(w, v, none, t, phases[i].from_s);
+      t = phases[i].from_s;
+    }
+    const double end = i + 1 < phases.size() ? std::min(t_s, phases[i + 1].from_s) : t_s;
+    if (end > t) {
+      p += turned_integral(w, v, phases[i].acceleration_mps2, t, end);
+      v += phases[i].acceleration_mps2 * (end - t);
+      t = end;
+    }
+  }
+  return p + turned_integral(w, v, none, t, t_s);
 }
 
 std::vector<std::string> validate(const Scenario& s) {
@@ -347,6 +463,10 @@ std::vector<std::string> validate(const Scenario& s) {
   const CameraMotion& m = s.camera_motion;
   c.require(std::isfinite(m.yaw_rate_dps), "camera_motion.yaw_rate_dps", m.yaw_rate_dps,
             "must be finite");
+  c.require(std::isfinite(m.pitch_deg) && std::abs(m.pitch_deg) <= 45, "camera_motion.pitch_deg",
+            m.pitch_deg, "must be in -45..45");
+  c.require(std::isfinite(m.roll_deg) && std::abs(m.roll_deg) <= 45, "camera_motion.roll_deg",
+            m.roll_deg, "must be in -45..45");
   c.require(std::isfinite(m.pitch_amplitude_deg) && std::abs(m.pitch_amplitude_deg) <= 45,
             "camera_motion.pitch_amplitude_deg", m.pitch_amplitude_deg, "must be in -45..45");
   c.require(std::isfinite(m.roll_amplitude_deg) && std::abs(m.roll_amplitude_deg) <= 45,
@@ -377,6 +497,35 @@ std::vector<std::string> validate(const Scenario& s) {
               f + ".from_s", step.from_s, "must be >= 0 and increase from step to step");
     c.require(std::isfinite(step.gain) && step.gain > 0, f + ".gain", step.gain, "must be > 0");
   }
+  c.require(std::isfinite(fx.exposure_time_s) && fx.exposure_time_s >= 0 &&
+                fx.exposure_time_s <= 0.1,
+            "effects.exposure_time_s", fx.exposure_time_s, "must be in 0..0.1");
+  const auto check_phases = [&](const std::vector<AccelerationPhase>& phases,
+                                const std::string& field) {
+    for (std::size_t k = 0; k < phases.size(); ++k) {
+      const AccelerationPhase& ph = phases[k];
+      const std::string f = field + "[" + std::to_string(k) + "]";
+      c.require(std::isfinite(ph.from_s) && ph.from_s >= 0 &&
+                    (k == 0 || ph.from_s > phases[k - 1].from_s),
+                f + ".from_s", ph.from_s, "must be >= 0 and increase from phase to phase");
+      c.require(finite(ph.acceleration_mps2), f + ".acceleration_mps2",
+                to_text(ph.acceleration_mps2), "must be finite");
+    }
+  };
+  check_phases(s.ego_accelerations, "ego_accelerations");
+  c.require(finite(s.shadows.to_light) && s.shadows.to_light[1] < 0, "shadows.to_light",
+            to_text(s.shadows.to_light), "must be finite and point up (y < 0)");
+  for (std::size_t k = 0; k < s.shadows.casters.size(); ++k) {
+    const ShadowCaster& sc = s.shadows.casters[k];
+    const std::string f = "shadows.casters[" + std::to_string(k) + "]";
+    c.require(finite(sc.position_m), f + ".position_m", to_text(sc.position_m), "must be finite");
+    c.require(finite(sc.velocity_mps), f + ".velocity_mps", to_text(sc.velocity_mps),
+              "must be finite");
+    c.require(std::isfinite(sc.radius_m) && sc.radius_m > 0, f + ".radius_m", sc.radius_m,
+              "must be > 0");
+    c.require(std::isfinite(sc.darkness) && sc.darkness >= 0 && sc.darkness <= 0.95,
+              f + ".darkness", sc.darkness, "must be in 0..0.95");
+  }
   for (const auto& e : core::validate(s.envelope)) out.push_back(e);
   std::set<int> ids;
   for (std::size_t i = 0; i < s.obstacles.size(); ++i) {
@@ -390,15 +539,7 @@ std::vector<std::string> validate(const Scenario& s) {
               "must be finite");
     c.require(finite(b.velocity_mps), field + ".velocity_mps", to_text(b.velocity_mps),
               "must be finite");
-    for (std::size_t k = 0; k < b.accelerations.size(); ++k) {
-      const AccelerationPhase& ph = b.accelerations[k];
-      const std::string f = field + ".accelerations[" + std::to_string(k) + "]";
-      c.require(std::isfinite(ph.from_s) && ph.from_s >= 0 &&
-                    (k == 0 || ph.from_s > b.accelerations[k - 1].from_s),
-                f + ".from_s", ph.from_s, "must be >= 0 and increase from phase to phase");
-      c.require(finite(ph.acceleration_mps2), f + ".acceleration_mps2",
-                to_text(ph.acceleration_mps2), "must be finite");
-    }
+    check_phases(b.accelerations, field + ".accelerations");
   }
   return out;
 }
@@ -440,6 +581,17 @@ std::string to_yaml(const Scenario& s) {
     e << YAML::Flow << YAML::BeginSeq << to_text(v[0]) << to_text(v[1]) << to_text(v[2])
       << YAML::EndSeq;
   };
+  const auto phases = [&](const std::vector<AccelerationPhase>& list) {
+    e << YAML::BeginSeq;
+    for (const AccelerationPhase& ph : list) {
+      e << YAML::Flow << YAML::BeginMap;
+      e << YAML::Key << "from_s" << YAML::Value << to_text(ph.from_s);
+      e << YAML::Key << "acceleration_mps2" << YAML::Value;
+      vec(ph.acceleration_mps2);
+      e << YAML::EndMap;
+    }
+    e << YAML::EndSeq;
+  };
   e << YAML::BeginMap;
   e << YAML::Key << "name" << YAML::Value << YAML::DoubleQuoted << s.name;
   e << YAML::Key << "description" << YAML::Value << YAML::DoubleQuoted << s.description;
@@ -457,8 +609,14 @@ std::string to_yaml(const Scenario& s) {
   e << YAML::Key << "ego_velocity_mps" << YAML::Value;
   vec(s.ego_velocity_mps);
   e << YAML::Key << "ego_follows_heading" << YAML::Value << s.ego_follows_heading;
+  if (!s.ego_accelerations.empty()) {
+    e << YAML::Key << "ego_accelerations" << YAML::Value;
+    phases(s.ego_accelerations);
+  }
   e << YAML::Key << "camera_motion" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "yaw_rate_dps" << YAML::Value << to_text(s.camera_motion.yaw_rate_dps);
+  e << YAML::Key << "pitch_deg" << YAML::Value << to_text(s.camera_motion.pitch_deg);
+  e << YAML::Key << "roll_deg" << YAML::Value << to_text(s.camera_motion.roll_deg);
   e << YAML::Key << "pitch_amplitude_deg" << YAML::Value
     << to_text(s.camera_motion.pitch_amplitude_deg);
   e << YAML::Key << "roll_amplitude_deg" << YAML::Value
@@ -470,11 +628,32 @@ std::string to_yaml(const Scenario& s) {
   e << YAML::Key << "background_height_m" << YAML::Value << to_text(s.background_height_m);
   e << YAML::Key << "ground_seed" << YAML::Value << s.ground_seed;
   e << YAML::Key << "background_seed" << YAML::Value << s.background_seed;
+  const auto kind = [](TextureKind k) { return texture_kind_names()[static_cast<std::size_t>(k)]; };
+  e << YAML::Key << "ground_texture" << YAML::Value << kind(s.ground_texture);
+  e << YAML::Key << "background_texture" << YAML::Value << kind(s.background_texture);
+  if (!s.shadows.casters.empty()) {
+    e << YAML::Key << "shadows" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "to_light" << YAML::Value;
+    vec(s.shadows.to_light);
+    e << YAML::Key << "casters" << YAML::Value << YAML::BeginSeq;
+    for (const ShadowCaster& c : s.shadows.casters) {
+      e << YAML::BeginMap;
+      e << YAML::Key << "position_m" << YAML::Value;
+      vec(c.position_m);
+      e << YAML::Key << "velocity_mps" << YAML::Value;
+      vec(c.velocity_mps);
+      e << YAML::Key << "radius_m" << YAML::Value << to_text(c.radius_m);
+      e << YAML::Key << "darkness" << YAML::Value << to_text(c.darkness);
+      e << YAML::EndMap;
+    }
+    e << YAML::EndSeq;
+    e << YAML::EndMap;
+  }
   e << YAML::Key << "noise_sigma" << YAML::Value << to_text(s.noise_sigma);
   e << YAML::Key << "right_gain" << YAML::Value << to_text(s.right_gain);
   e << YAML::Key << "noise_seed" << YAML::Value << s.noise_seed;
   e << YAML::Key << "edge_samples" << YAML::Value << s.edge_samples;
-  if (s.effects.any()) {
+  if (s.effects.any() || s.effects.exposure_time_s != 0.0) {
     e << YAML::Key << "effects" << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "exposure_steps" << YAML::Value << YAML::BeginSeq;
     for (const ExposureStep& step : s.effects.exposure_steps) {
@@ -487,6 +666,7 @@ std::string to_yaml(const Scenario& s) {
     e << YAML::Key << "vignetting" << YAML::Value << to_text(s.effects.vignetting);
     e << YAML::Key << "right_shift_y_px" << YAML::Value << to_text(s.effects.right_shift_y_px);
     e << YAML::Key << "jpeg_quality" << YAML::Value << s.effects.jpeg_quality;
+    e << YAML::Key << "exposure_time_s" << YAML::Value << to_text(s.effects.exposure_time_s);
     e << YAML::EndMap;
   }
   e << YAML::Key << "envelope" << YAML::Value << YAML::BeginMap;
@@ -508,17 +688,11 @@ std::string to_yaml(const Scenario& s) {
     e << YAML::Key << "velocity_mps" << YAML::Value;
     vec(b.velocity_mps);
     if (!b.accelerations.empty()) {
-      e << YAML::Key << "accelerations" << YAML::Value << YAML::BeginSeq;
-      for (const AccelerationPhase& ph : b.accelerations) {
-        e << YAML::Flow << YAML::BeginMap;
-        e << YAML::Key << "from_s" << YAML::Value << to_text(ph.from_s);
-        e << YAML::Key << "acceleration_mps2" << YAML::Value;
-        vec(ph.acceleration_mps2);
-        e << YAML::EndMap;
-      }
-      e << YAML::EndSeq;
+      e << YAML::Key << "accelerations" << YAML::Value;
+      phases(b.accelerations);
     }
     e << YAML::Key << "texture_seed" << YAML::Value << b.texture_seed;
+    e << YAML::Key << "texture" << YAML::Value << kind(b.texture);
     e << YAML::EndMap;
   }
   e << YAML::EndSeq;

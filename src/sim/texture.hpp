@@ -89,4 +89,59 @@ inline double texture_value(double u, double v, std::uint32_t seed, double footp
   return sum * (1.0 / 3.6);
 }
 
+inline double smoothstep01(double a) {
+  a = a < 0.0 ? 0.0 : (a > 1.0 ? 1.0 : a);
+  return a * a * (3.0 - 2.0 * a);
+}
+
+/// A square wave of `period` m in [-1, 1] at coordinate a, prefiltered for a pixel footprint of
+/// `footprint_m`: a sine steepened until its edges span one footprint, fading to its mean (0) as
+/// the footprint nears half a period.
+inline double soft_square(double a, double period, double footprint_m) {
+  constexpr double kTwoPi = 6.283185307179586;
+  const double slope = kTwoPi * footprint_m / period;  // the sine's change over one footprint
+  double v = std::sin(kTwoPi * a / period) / (slope > 1e-9 ? slope : 1e-9);
+  v = v > 1.0 ? 1.0 : (v < -1.0 ? -1.0 : v);
+  return v * (1.0 - smoothstep01((footprint_m / period - 0.2) / 0.3));
+}
+
+/// Surface value in about [-1, 1] of a TextureKind (sg/sim/scenario.hpp; passed as its index so
+/// that this header stays free of the scenario): 0 noise, 1 low, 2 tiles, 3 stripes, 4 clutter.
+/// Sizes (tile side, stripe period and angle, glyph height) follow from the seed.
+inline double pattern_value(int kind, double u, double v, std::uint32_t seed, double footprint_m) {
+  const double noise = texture_value(u, v, seed, footprint_m);
+  if (kind == 0) return noise;
+  if (kind == 1) return 0.125 * noise;
+  const std::uint32_t h = hash_u32(seed ^ 0x51ed270bU);
+  const double r1 = (h & 0xffffU) / 65535.0, r2 = (h >> 16) / 65535.0;
+  if (kind == 2) {  // tiles: a checkerboard of 0.15..0.6 m squares
+    const double side = 0.15 + 0.45 * r1;
+    return 0.6 * soft_square(u, 2.0 * side, footprint_m) * soft_square(v, 2.0 * side, footprint_m) +
+           0.15 * noise;
+  }
+  if (kind == 3) {  // stripes: period 0.05..0.3 m at an angle 0..180 deg
+    const double period = 0.05 + 0.25 * r1, angle = 3.141592653589793 * r2;
+    return 0.6 * soft_square(u * std::cos(angle) + v * std::sin(angle), period, footprint_m) +
+           0.15 * noise;
+  }
+  // clutter: lines of glyphs of 3 x 5 marks, glyph height 0.03..0.1 m, a line every 1.6 heights
+  const double glyph_h = 0.03 + 0.07 * r1, glyph_w = 0.6 * glyph_h, line = 1.6 * glyph_h;
+  const double mark = glyph_h / 5.0;
+  const double weight = 1.0 - smoothstep01(footprint_m / mark - 0.5);
+  constexpr double kMean = 0.2;  // the mean of paper and ink, where the marks fade out
+  if (weight <= 0.0) return kMean + 0.15 * noise;
+  const double cu = std::floor(u / glyph_w), cv = std::floor(v / line);
+  const double fu = u / glyph_w - cu, fv = (v / line - cv) * 1.6;  // fv in glyph heights
+  double value = 0.4;                                               // paper
+  if (fv < 1.0) {
+    const std::uint32_t g = hash_combine(
+        hash_combine(seed, static_cast<std::uint32_t>(static_cast<std::int64_t>(cu))),
+        static_cast<std::uint32_t>(static_cast<std::int64_t>(cv)));
+    const int col = static_cast<int>(fu * 4.0), row = static_cast<int>(fv * 5.0);
+    // Columns 0..2 carry marks, column 3 is the gap between glyphs; one glyph in six is a space.
+    if (col < 3 && g % 6U != 0U && ((g >> (1 + row * 3 + col)) & 1U)) value = -0.6;  // ink
+  }
+  return kMean + weight * (value - kMean) + 0.15 * noise;
+}
+
 }  // namespace sg::sim

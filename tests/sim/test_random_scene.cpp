@@ -43,7 +43,8 @@ TEST(RandomScene, DifferentSeedsDiffer) {
 TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
   const RandomSceneRanges& r = kRandomSceneRanges;
   std::set<std::string> platforms, shapes, paths, motions;
-  int with_jpeg = 0, clear = 0;
+  int with_jpeg = 0, clear = 0, with_shadows = 0;
+  std::set<TextureKind> textures;
   for (std::uint32_t seed = 1000; seed < 1500; ++seed) {
     RandomSceneInfo info;
     const Scenario s = random_scenario(seed, &info);
@@ -61,7 +62,7 @@ TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
                                               [&](const char* n) { return info.platform == n; }) -
                                  kRandomPlatforms.begin());
     ASSERT_LT(p, kRandomPlatforms.size());
-    EXPECT_EQ(s.platform, info.platform == "drone" ? "robot" : info.platform);
+    EXPECT_EQ(s.platform, info.platform);
     EXPECT_TRUE(within(s.height_m, r.height_m[p]));
     const double speed = s.ego_velocity_mps[2];
     if (info.ego_motion == "still") {
@@ -69,6 +70,32 @@ TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
     }
     if (info.ego_motion == "forward") {
       EXPECT_TRUE(within(speed, r.ego_speed_mps[p]));
+    }
+    const double duration = s.frames / c.fps;
+    if (info.ego_motion == "accelerating") {
+      // Reaches its full speed after the ramp, from a share of it.
+      const double full = ego_velocity(s, r.speed_ramp_s.hi + 0.1)[2];
+      EXPECT_TRUE(within(full, r.ego_speed_mps[p]));
+      EXPECT_LE(speed, r.start_speed_share.hi * full + 1e-9);
+    } else if (info.ego_motion == "stopping") {
+      EXPECT_TRUE(within(speed, r.ego_speed_mps[p]));
+      EXPECT_NEAR(ego_velocity(s, duration * r.brake_start_share.hi + r.brake_ramp_s.hi)[2], 0.0,
+                  1e-9);
+    } else {
+      EXPECT_TRUE(s.ego_accelerations.empty());
+    }
+    EXPECT_TRUE(within(s.camera_motion.pitch_deg, r.pitch_deg));
+    EXPECT_TRUE(within(s.camera_motion.roll_deg, r.roll_deg));
+    EXPECT_TRUE(within(s.effects.exposure_time_s * 1e3, r.exposure_time_ms));
+    EXPECT_LE(s.effects.exposure_time_s, 0.9 / c.fps + 1e-12);
+    textures.insert(s.ground_texture);
+    textures.insert(s.background_texture);
+    EXPECT_LE(static_cast<int>(s.shadows.casters.size()), r.max_shadow_casters);
+    with_shadows += s.shadows.casters.empty() ? 0 : 1;
+    for (const ShadowCaster& caster : s.shadows.casters) {
+      EXPECT_TRUE(within(caster.radius_m, r.caster_radius_m));
+      EXPECT_TRUE(within(caster.darkness, r.shadow_darkness));
+      EXPECT_TRUE(within(s.height_m - caster.position_m[1], r.caster_height_m, 1e-6));
     }
     if (info.ego_motion == "turning") {
       EXPECT_TRUE(within(std::abs(s.camera_motion.yaw_rate_dps), r.yaw_rate_dps));
@@ -110,6 +137,7 @@ TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
                          {0.0, r.obstacle_speed_mps[p].hi + r.ego_speed_mps[p].hi}));
       EXPECT_LT(s.obstacles[i].position_m[2] + 0.5 * s.obstacles[i].size_m[2], s.background_z_m);
       shapes.insert(info.shapes[i]);
+      textures.insert(s.obstacles[i].texture);
       paths.insert(info.paths[i]);
     }
     clear += s.obstacles.empty() ? 1 : 0;
@@ -121,7 +149,9 @@ TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
   EXPECT_EQ(shapes.size(), kRandomShapes.size());
   EXPECT_EQ(paths.size(), kRandomPaths.size());
   EXPECT_EQ(motions.size(), kRandomEgoMotions.size());
+  EXPECT_EQ(textures.size(), texture_kind_names().size());
   EXPECT_GT(with_jpeg, 150);
+  EXPECT_GT(with_shadows, 120);
   EXPECT_GT(clear, 50);
 }
 

@@ -132,10 +132,17 @@ TEST(Scenario, YamlRoundTripKeepsEveryField) {
   s.envelope = {0.6, -0.9, 0.8, 0.4, 2.5};
   s.min_area_px = 77;
   s.obstacles[1].texture_seed = 1234;
-  s.camera_motion = {12.5, 2.0, -1.5, 1.75};
-  s.platform = "walker";
+  s.camera_motion = {12.5, 2.0, -1.5, 1.75, -4.5, 2.25};
+  s.platform = "drone";
   s.ego_follows_heading = true;
   s.obstacles[0].accelerations = {{0.5, {1.0, 0.0, -2.0}}, {1.25, {0, 0, 0}}};
+  s.ego_accelerations = {{0.25, {0.0, 0.0, -1.5}}, {1.5, {0, 0, 0}}};
+  s.obstacles[1].texture = TextureKind::kClutter;
+  s.ground_texture = TextureKind::kTiles;
+  s.background_texture = TextureKind::kStripes;
+  s.shadows.to_light = {0.25, -0.75, 0.5};
+  s.shadows.casters = {{{1.0, -3.0, 9.0}, {0.5, 0.0, -0.25}, 1.5, 0.625}};
+  s.effects.exposure_time_s = 0.0125;
   const std::string path = write_file("roundtrip.yaml", "");
   save_scenario_file(s, path);
   const Scenario r = load_scenario_file(path);
@@ -145,7 +152,24 @@ TEST(Scenario, YamlRoundTripKeepsEveryField) {
   EXPECT_EQ(r.camera_motion.pitch_amplitude_deg, 2.0);
   EXPECT_EQ(r.camera_motion.roll_amplitude_deg, -1.5);
   EXPECT_EQ(r.camera_motion.oscillation_hz, 1.75);
-  EXPECT_EQ(r.platform, "walker");
+  EXPECT_EQ(r.camera_motion.pitch_deg, -4.5);
+  EXPECT_EQ(r.camera_motion.roll_deg, 2.25);
+  EXPECT_EQ(r.platform, "drone");
+  ASSERT_EQ(r.ego_accelerations.size(), 2u);
+  EXPECT_EQ(r.ego_accelerations[0].from_s, 0.25);
+  EXPECT_EQ(r.ego_accelerations[0].acceleration_mps2, cv::Vec3d(0.0, 0.0, -1.5));
+  EXPECT_EQ(r.obstacles[0].texture, TextureKind::kNoise);
+  EXPECT_EQ(r.obstacles[1].texture, TextureKind::kClutter);
+  EXPECT_EQ(r.ground_texture, TextureKind::kTiles);
+  EXPECT_EQ(r.background_texture, TextureKind::kStripes);
+  EXPECT_EQ(r.shadows.to_light, cv::Vec3d(0.25, -0.75, 0.5));
+  ASSERT_EQ(r.shadows.casters.size(), 1u);
+  EXPECT_EQ(r.shadows.casters[0].position_m, cv::Vec3d(1.0, -3.0, 9.0));
+  EXPECT_EQ(r.shadows.casters[0].velocity_mps, cv::Vec3d(0.5, 0.0, -0.25));
+  EXPECT_EQ(r.shadows.casters[0].radius_m, 1.5);
+  EXPECT_EQ(r.shadows.casters[0].darkness, 0.625);
+  EXPECT_EQ(r.effects.exposure_time_s, 0.0125);
+  EXPECT_EQ(to_yaml(r), to_yaml(s));
   EXPECT_TRUE(r.ego_follows_heading);
   ASSERT_EQ(r.obstacles[0].accelerations.size(), 2u);
   EXPECT_EQ(r.obstacles[0].accelerations[0].from_s, 0.5);
@@ -236,6 +260,11 @@ TEST(Scenario, BadFilesNameTheFileAndField) {
       {"frames.yaml", "frames: 1\n", "frames=1"},
       {"dup.yaml", "obstacles:\n  - id: 2\n  - id: 2\n", "obstacles[1].id=2"},
       {"empty.yaml", "", "empty"},
+      {"texture.yaml", "ground_texture: marble\n", "ground_texture"},
+      {"shadow.yaml", "shadows:\n  casters:\n    - {darkness: 2}\n", "shadows.casters[0].darkness=2"},
+      {"light.yaml", "shadows:\n  to_light: [0, 1, 0]\n", "shadows.to_light"},
+      {"blur.yaml", "effects: {exposure_time_s: 0.5}\n", "effects.exposure_time_s=0.5"},
+      {"ego.yaml", "ego_accelerations:\n  - {from_s: -1}\n", "ego_accelerations[0].from_s=-1"},
   };
   for (const Case& c : cases) {
     const std::string path = write_file(c.file, c.text);

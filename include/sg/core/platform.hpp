@@ -9,7 +9,7 @@
 
 namespace sg::core {
 
-/// "robot" (the defaults), "walker", "car".
+/// "robot" (the defaults), "walker", "car", "drone".
 std::vector<std::string> platform_names();
 
 /// The safety envelope of a platform (camera frame, m, s). Throws InputError for an unknown name.
@@ -18,6 +18,8 @@ std::vector<std::string> platform_names();
 ///    20 cm above the ground), contact 0.4 m.
 ///  * car (camera behind the windscreen, about 1.3 m up, 2 m behind the front bumper):
 ///    |X| <= 1.0, -0.4 <= Y <= 1.1, contact 2.0 m.
+///  * drone (a small multicopter, the camera at its centre, flying at up to 6 m/s): |X| <= 0.6,
+///    -0.4 <= Y <= 0.4 (rotors and a margin, the ground below stays out), contact 1.0 m.
 Envelope platform_envelope(const std::string& name);
 
 /// Sets the fields a platform governs, whatever they held before (so presets can be applied
@@ -25,7 +27,8 @@ Envelope platform_envelope(const std::string& name);
 /// scene_flow.ground.z_max_m; scene_flow.predict_turn. robot and walker keep the defaults (64
 /// disparities, 12 / 20 / 12 m, the straight line ahead); car: 128 disparities (nearest depth
 /// f*B/128, 1.4 m at f 600 px, B 0.30 m), 40 / 60 / 40 m (a stopped car is 3 s away at 32 m at
-/// 10 m/s), and the arc it drives through a bend. "" leaves `params` as it is.
+/// 10 m/s), and the arc it drives through a bend; drone: 25 / 30 m (3 s ahead at 6 m/s plus the
+/// contact distance), the straight line ahead. "" leaves `params` as it is.
 /// Throws InputError naming the known platforms for an unknown name.
 void apply_platform(const std::string& name, DetectorParams& params);
 

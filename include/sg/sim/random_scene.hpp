@@ -16,7 +16,7 @@ struct SampleRange {
   double hi = 0.0;
 };
 
-/// The platforms a scene is made for. A drone has no detector preset: its scenes use "robot".
+/// The platforms a scene is made for; each names its detector preset (core::platform_names).
 inline constexpr std::array<const char*, 4> kRandomPlatforms = {"walker", "robot", "car", "drone"};
 /// Obstacle shapes (docs/random-suite.md): sizes in RandomSceneRanges.
 inline constexpr std::array<const char*, 6> kRandomShapes = {"box", "pole", "person",
@@ -24,8 +24,9 @@ inline constexpr std::array<const char*, 6> kRandomShapes = {"box", "pole", "per
 /// Obstacle paths relative to the camera.
 inline constexpr std::array<const char*, 6> kRandomPaths = {"head-on",   "oblique",  "crossing",
                                                             "near-miss", "receding", "stopped"};
-/// Ego motions.
-inline constexpr std::array<const char*, 3> kRandomEgoMotions = {"forward", "turning", "still"};
+/// Ego motions: "accelerating" starts slower and speeds up, "stopping" brakes to a standstill.
+inline constexpr std::array<const char*, 5> kRandomEgoMotions = {"forward", "turning", "still",
+                                                                 "accelerating", "stopping"};
 /// Image sizes a scene picks from (width x height, px): 320x240 to 1280x720.
 inline constexpr std::array<std::array<int, 2>, 6> kRandomImageSizes = {
     {{320, 240}, {424, 240}, {640, 360}, {640, 480}, {848, 480}, {1280, 720}}};
@@ -43,6 +44,15 @@ struct RandomSceneRanges {
   std::array<SampleRange, 4> obstacle_speed_mps{{{0.3, 2.0}, {0.3, 2.0}, {1.0, 12.0}, {0.3, 3.0}}};
   /// |yaw rate| of a "turning" ego motion (either sign); it keeps 0..1 of its forward speed.
   SampleRange yaw_rate_dps{5.0, 25.0};
+  /// "accelerating": starts at this share of its speed, reaches the speed after the ramp.
+  SampleRange start_speed_share{0.0, 0.5};
+  SampleRange speed_ramp_s{1.0, 2.5};
+  /// "stopping": brakes from this share of the scene's duration on, over the ramp.
+  SampleRange brake_start_share{0.1, 0.6};
+  SampleRange brake_ramp_s{0.5, 2.0};
+  /// Fixed mounting tilt (positive pitch looks up).
+  SampleRange pitch_deg{-5.0, 5.0};
+  SampleRange roll_deg{-3.0, 3.0};
   /// Camera sway amplitudes for walker and drone; robot and car sway a third of it.
   SampleRange pitch_amplitude_deg{0.0, 3.0};
   SampleRange roll_amplitude_deg{0.0, 3.0};
@@ -69,6 +79,19 @@ struct RandomSceneRanges {
   /// Drones meet obstacles at flight level: their centre's Y (camera frame at t = 0), m.
   SampleRange drone_obstacle_y_m{-0.5, 0.5};
   SampleRange background_z_m{15.0, 60.0};
+  /// Chance of each texture kind (indexed like sim::texture_kind_names(): noise, low, tiles,
+  /// stripes, clutter), drawn for the ground, the background and each obstacle.
+  std::array<double, 5> texture_weights{0.4, 0.15, 0.15, 0.15, 0.15};
+  // Moving cast shadows: in this share of scenes, 1..max casters.
+  double shadow_probability = 0.4;
+  int max_shadow_casters = 2;
+  SampleRange sun_elevation_deg{25.0, 70.0};  ///< the light's direction, any azimuth
+  SampleRange caster_height_m{2.0, 8.0};      ///< above the ground
+  SampleRange caster_radius_m{0.5, 3.0};
+  SampleRange caster_speed_mps{0.3, 3.0};  ///< horizontal, any direction
+  SampleRange shadow_darkness{0.3, 0.7};
+  SampleRange shadow_ahead_m{2.0, 20.0};  ///< its shadow starts this far ahead on the ground ...
+  SampleRange shadow_side_m{-5.0, 5.0};   ///< ... and this far to the side
   // Light and sensor.
   SampleRange noise_sigma{0.0, 4.0};  ///< gray levels
   SampleRange right_gain{0.85, 1.15};
@@ -78,6 +101,8 @@ struct RandomSceneRanges {
   SampleRange exposure_gain{0.7, 1.3};  ///< gain of each step
   double jpeg_probability = 0.5;        ///< share of scenes with a JPEG round trip
   SampleRange jpeg_quality{40.0, 95.0};
+  /// Exposure time (motion blur), capped at 0.9 of the frame interval.
+  SampleRange exposure_time_ms{0.0, 20.0};
 };
 
 /// The ranges random_scenario samples from.
@@ -85,7 +110,7 @@ inline constexpr RandomSceneRanges kRandomSceneRanges{};
 
 /// What a random scene drew beyond the Scenario's fields (for reports and tests).
 struct RandomSceneInfo {
-  std::string platform;    ///< one of kRandomPlatforms ("drone" runs the "robot" preset)
+  std::string platform;    ///< one of kRandomPlatforms (and the preset the scene names)
   std::string ego_motion;  ///< one of kRandomEgoMotions
   std::vector<std::string> shapes, paths;      ///< per obstacle, like Scenario::obstacles
   std::vector<double> start_ttc_over_horizon;  ///< per obstacle, the sampled start factor

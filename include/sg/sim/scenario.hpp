@@ -18,6 +18,16 @@ struct AccelerationPhase {
   cv::Vec3d acceleration_mps2{0, 0, 0};  ///< world frame, m/s^2
 };
 
+/// Surface texture kinds (docs/random-suite.md): value noise at every scale ("noise", the
+/// default), the same at an eighth of its contrast ("low"), a checkerboard of tiles ("tiles"),
+/// parallel stripes at an angle ("stripes"), and rows of glyph-like marks ("clutter"). The
+/// periodic kinds keep a weak noise on top, as real tiles and paint do.
+enum class TextureKind : std::uint8_t { kNoise, kLow, kTiles, kStripes, kClutter };
+/// Names of the texture kinds, indexed by the enum: "noise", "low", "tiles", "stripes", "clutter".
+const std::vector<std::string>& texture_kind_names();
+/// The kind of `name`; throws core::InputError listing the names for an unknown one.
+TextureKind texture_kind(const std::string& name);
+
 /// An axis-aligned box (world frame). A pole is a narrow box from the ground up; an overhang is a
 /// box whose bottom is above the ground (nothing below it).
 struct Box {
@@ -28,6 +38,7 @@ struct Box {
   /// Piecewise-constant acceleration (empty: constant velocity); before the first phase, none.
   std::vector<AccelerationPhase> accelerations;
   std::uint32_t texture_seed = 1;      ///< texture fixed to the box
+  TextureKind texture = TextureKind::kNoise;
 };
 
 /// Centre of the box at time t_s, world frame, m (integrates the acceleration phases exactly).
@@ -37,18 +48,39 @@ cv::Vec3d box_velocity(const Box& box, double t_s);
 
 /// The camera's own rotation (the left camera turns about its optical centre). Camera-to-world
 /// rotation at time t: R(t) = R_y(yaw) R_x(pitch) R_z(roll), with yaw = yaw_rate * t (positive
-/// turns right: the optical axis swings towards +X), pitch = pitch_amplitude sin(2 pi f t)
-/// (positive looks up), roll = roll_amplitude sin(2 pi f t + pi/2), f = oscillation_hz: a
-/// walking or flying platform. All zero (the default): the camera keeps the world axes.
+/// turns right: the optical axis swings towards +X), pitch = pitch_deg + pitch_amplitude
+/// sin(2 pi f t) (positive looks up), roll = roll_deg + roll_amplitude sin(2 pi f t + pi/2),
+/// f = oscillation_hz: a mounting tilt plus the sway of a walking or flying platform. All zero
+/// (the default): the camera keeps the world axes.
 struct CameraMotion {
   double yaw_rate_dps = 0.0;         ///< deg/s
   double pitch_amplitude_deg = 0.0;  ///< deg
   double roll_amplitude_deg = 0.0;   ///< deg
   double oscillation_hz = 1.0;       ///< Hz, > 0
+  double pitch_deg = 0.0;            ///< fixed pitch of the mounting, deg, -45..45
+  double roll_deg = 0.0;             ///< fixed roll of the mounting, deg, -45..45
   /// True when any rotation is set.
   bool rotates() const {
-    return yaw_rate_dps != 0.0 || pitch_amplitude_deg != 0.0 || roll_amplitude_deg != 0.0;
+    return yaw_rate_dps != 0.0 || pitch_deg != 0.0 || roll_deg != 0.0 ||
+           pitch_amplitude_deg != 0.0 || roll_amplitude_deg != 0.0;
   }
+};
+
+/// A shadow caster out of view (a tree, a cloud, a passer-by): a sphere whose shadow, cast along
+/// Shadows::to_light, darkens the ground, the background and the boxes it falls on.
+struct ShadowCaster {
+  cv::Vec3d position_m{0, -5, 10};  ///< centre at t = 0, world frame, m
+  cv::Vec3d velocity_mps{0, 0, 0};  ///< world frame, m/s
+  double radius_m = 1.0;            ///< > 0; the penumbra spans 0.85..1.15 of it
+  double darkness = 0.5;            ///< share of the light it blocks in its umbra, 0..0.95
+};
+
+/// Moving cast shadows: a surface point P is shaded by (1 - darkness) where the ray P + s L
+/// (s > 0, L = to_light normalised) passes within the umbra of a caster. The truth maps ignore
+/// them (a shadow is not an obstacle).
+struct Shadows {
+  cv::Vec3d to_light{0.3, -1.0, -0.4};  ///< direction towards the light, world frame (y down)
+  std::vector<ShadowCaster> casters;    ///< none: no shadow
 };
 
 /// From time from_s on (until the next step), every pixel of both images is multiplied by gain:
@@ -70,7 +102,12 @@ struct ImageEffects {
   double right_shift_y_px = 0.0;
   /// JPEG quality of a compress-decompress round trip of each image, 1..100; 0 = none.
   int jpeg_quality = 0;
-  /// True when any effect is set.
+  /// Exposure time, s, 0..0.1 (0 = an instant): each image is the mean of the scene over
+  /// [t - e/2, t + e/2], approximated by sampling it along each pixel's own image motion (the
+  /// ground-truth flow of that camera scaled to the exposure); applied before noise and the
+  /// effects above.
+  double exposure_time_s = 0.0;
+  /// True when any effect applied after rendering is set (exposure_time_s is part of rendering).
   bool any() const {
     return !exposure_steps.empty() || vignetting != 0.0 || right_shift_y_px != 0.0 ||
            jpeg_quality != 0;
@@ -81,8 +118,13 @@ struct ImageEffects {
 cv::Matx33d camera_rotation(const CameraMotion& m, double t_s);
 
 struct Scenario;
-/// The camera's position at time t_s, world frame, m (the origin at t = 0): ego_velocity_mps t,
-/// or with ego_follows_heading that velocity turned with the heading's yaw and integrated.
+/// The camera's velocity at time t_s in the frame ego_velocity_mps is given in (world, or the
+/// heading's with ego_follows_heading): ego_velocity_mps plus the integral of ego_accelerations.
+cv::Vec3d ego_heading_velocity(const Scenario& s, double t_s);
+/// The camera's velocity at time t_s, world frame, m/s.
+cv::Vec3d ego_velocity(const Scenario& s, double t_s);
+/// The camera's position at time t_s, world frame, m (the origin at t = 0): the integral of
+/// ego_velocity (closed form, also through a turn).
 cv::Vec3d ego_position(const Scenario& s, double t_s);
 
 struct Scenario {
@@ -97,6 +139,9 @@ struct Scenario {
   /// the camera's heading, which turns at camera_motion.yaw_rate_dps, so that the camera drives
   /// along an arc of radius |v| / yaw rate, as a car does through a bend.
   bool ego_follows_heading = false;
+  /// Piecewise-constant acceleration of the camera, in the frame of ego_velocity_mps (empty:
+  /// constant speed); a platform that speeds up or brakes. Phases as for Box::accelerations.
+  std::vector<AccelerationPhase> ego_accelerations;
   /// Platform preset the scenario is made for ("" = none, "robot", "walker", "car";
   /// core::platform_names()): `run` and `eval` apply its detector settings unless --platform or
   /// the config's `platform` key chooses another.
@@ -107,6 +152,9 @@ struct Scenario {
   double background_height_m = 15.0;
   std::uint32_t ground_seed = 11;         ///< ground texture
   std::uint32_t background_seed = 12;     ///< background texture
+  TextureKind ground_texture = TextureKind::kNoise;
+  TextureKind background_texture = TextureKind::kNoise;
+  Shadows shadows;                        ///< moving cast shadows (default: none)
   double noise_sigma = 1.0;               ///< Gaussian pixel noise, gray levels (0 = none)
   double right_gain = 1.0;                ///< brightness gain of the right camera (photometric mismatch)
   std::uint32_t noise_seed = 7;           ///< noise is a fixed function of (seed, frame, side)
