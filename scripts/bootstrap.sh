@@ -7,7 +7,7 @@ preset="${1:-release}"
 
 packages=(build-essential cmake ninja-build pkg-config libopencv-dev libtbb-dev libgtest-dev
           libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libyaml-cpp-dev
-          libhwy-dev libboost-graph-dev ffmpeg gnuplot-nox opencv-doc clang-14 libclang-rt-14-dev
+          libhwy-dev libboost-graph-dev libdeflate-dev ffmpeg gnuplot-nox opencv-doc clang-14 libclang-rt-14-dev
           pybind11-dev python3-pybind11 python3-pytest python3-numpy python3-matplotlib xvfb
           x11-apps xdotool)
 missing=()

@@ -1,5 +1,7 @@
 #include "gray.hpp"
 
+#include <cstring>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -37,7 +39,37 @@ cv::Mat to_gray8(const cv::Mat& raw, const std::string& what) {
   return gray;
 }
 
+}  // namespace sg::io::detail
+
+namespace sg::io {
+namespace {
+
+/// The whole file when it starts with the PNG signature, else empty.
+std::vector<std::uint8_t> png_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[8] = {};
+  if (!in.read(head, sizeof(head)) || std::memcmp(head, "\x89PNG\r\n\x1a\n", 8) != 0) return {};
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size <= 0) return {};
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), size)) return {};
+  return bytes;
+}
+
+}  // namespace
+
 cv::Mat read_gray(const std::filesystem::path& path) {
+  const std::vector<std::uint8_t> bytes = png_bytes(path);
+  if (!bytes.empty()) {
+    cv::Mat image = decode_gray8_png(bytes);
+    if (!image.empty()) return image;
+  }
+  return read_gray_opencv(path);
+}
+
+cv::Mat read_gray_opencv(const std::filesystem::path& path) {
   cv::Mat raw;
   try {
     raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
@@ -48,8 +80,12 @@ cv::Mat read_gray(const std::filesystem::path& path) {
     throw core::InputError("cannot read image (missing, corrupt or not an image): " +
                            path.string());
   }
-  return to_gray8(raw, path.string());
+  return detail::to_gray8(raw, path.string());
 }
+
+}  // namespace sg::io
+
+namespace sg::io::detail {
 
 std::string size_text(cv::Size s) {
   return std::to_string(s.width) + "x" + std::to_string(s.height);

@@ -438,13 +438,13 @@ void apply_effects(const ImageEffects& fx, double t_s, cv::Mat& left, cv::Mat& r
 /// `gray` sampled at p + flow(p) * share * (1/2 - k / (n - 1)), k = 0..n-1, with flow the
 /// backward flow of one frame and share the exposure over the frame interval, then `noise`.
 void blur_and_add_noise(cv::Mat& gray, const cv::Mat& flow, double share, const cv::Mat& noise) {
-  double longest = 0.0;
+  double longest2 = 0.0;
   for (int y = 0; y < flow.rows; ++y) {
     const auto* q = flow.ptr<cv::Vec2f>(y);
     for (int x = 0; x < flow.cols; ++x)
-      longest = std::max(longest, std::hypot(static_cast<double>(q[x][0]), q[x][1]));
+      longest2 = std::max(longest2, static_cast<double>(q[x][0] * q[x][0] + q[x][1] * q[x][1]));
   }
-  const int n = std::clamp(static_cast<int>(std::ceil(longest * share)) + 1, 2, 12);
+  const int n = std::clamp(static_cast<int>(std::ceil(std::sqrt(longest2) * share)) + 1, 2, 12);
   cv::Mat source, sum = cv::Mat::zeros(gray.size(), CV_32FC1), sample;
   gray.convertTo(source, CV_32FC1);
   cv::Mat map(gray.size(), CV_32FC2);
