@@ -478,28 +478,12 @@ core::ObstacleTruth turning_collision(const Scenario& s, const Box& box, double 
   const cv::Vec3d centre = box_position(box, t_s), velocity = box_velocity(box, t_s);
   const cv::Vec3d half = box.size_m * 0.5;
   const int steps = static_cast<int>(std::ceil(e.horizon_s / kStep));
-  const bool steady = s.ego_accelerations.empty();
-  const cv::Vec3d eye_now = ego_position(s, t_s);
-  Scenario coasting;  // the camera from t_s on at its velocity then, for the path ahead
-  if (!steady) {
-    coasting.ego_velocity_mps = ego_heading_velocity(s, t_s);
-    coasting.ego_follows_heading = s.ego_follows_heading;
-    coasting.camera_motion.yaw_rate_dps = s.camera_motion.yaw_rate_dps;
-  }
-  const double w = s.camera_motion.yaw_rate_dps * CV_PI / 180.0;
-  const auto steady_path = [&](double tau) {
-    // The heading at t_s turns the coasting path, which starts at heading 0.
-    const cv::Vec3d d = ego_position(coasting, tau);
-    if (!s.ego_follows_heading || w == 0.0) return d;
-    const double c = std::cos(w * t_s), sn = std::sin(w * t_s);
-    return cv::Vec3d(c * d[0] + sn * d[2], d[1], -sn * d[0] + c * d[2]);
-  };
   for (int i = 0; i <= steps; ++i) {
     const double tau = std::min(i * kStep, e.horizon_s);
     const cv::Matx33d to_camera = camera_rotation(s.camera_motion, t_s + tau).t();
     // The camera on its path at its current speed (ego accelerations are not foreseen, as the
     // box's are not).
-    const cv::Vec3d eye = steady ? ego_position(s, t_s + tau) : eye_now + steady_path(tau);
+    const cv::Vec3d eye = ego_coasting_position(s, t_s, tau);
     const cv::Vec3d c = centre + velocity * tau;
     cv::Vec3d lo(kInf, kInf, kInf), hi(-kInf, -kInf, -kInf);
     for (int k = 0; k < 8; ++k) {

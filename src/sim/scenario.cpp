@@ -319,27 +319,40 @@ Scenario read_scenario(const YamlReader& r, const YAML::Node& root, const std::s
 
 namespace {
 
-/// Position and velocity after moving from (p, v) at time 0 to time t_s under `phases`
-/// (piecewise-constant acceleration, none before the first phase).
-void integrate_phases(const std::vector<AccelerationPhase>& phases, double t_s, cv::Vec3d& p,
-                      cv::Vec3d& v) {
-  double t = 0.0;  // p, v hold the state at time t
+/// Walks `phases` (piecewise-constant acceleration, none before the first phase) from time 0,
+/// at velocity v then, to time t_s: calls segment(v, a, t0, t1) for each stretch [t0, t1] of
+/// constant acceleration, v the velocity at t0 and a null while coasting. Returns the velocity
+/// at t_s.
+template <typename Segment>
+cv::Vec3d walk_phases(const std::vector<AccelerationPhase>& phases, double t_s, cv::Vec3d v,
+                      Segment&& segment) {
+  double t = 0.0;  // v holds the velocity at time t
   for (std::size_t i = 0; i < phases.size(); ++i) {
     const AccelerationPhase& ph = phases[i];
     if (ph.from_s >= t_s) break;
-    if (ph.from_s > t) {  // coast from t to the phase start (no acceleration before phase 0)
-      p += v * (ph.from_s - t);
+    if (ph.from_s > t) {  // coast from t to the phase start
+      segment(v, nullptr, t, ph.from_s);
       t = ph.from_s;
     }
     const double end = i + 1 < phases.size() ? std::min(t_s, phases[i + 1].from_s) : t_s;
-    const double span = end - t;
-    if (span > 0) {
-      p += v * span + ph.acceleration_mps2 * (0.5 * span * span);
-      v += ph.acceleration_mps2 * span;
+    if (end > t) {
+      segment(v, &ph.acceleration_mps2, t, end);
+      v += ph.acceleration_mps2 * (end - t);
       t = end;
     }
   }
-  p += v * (t_s - t);
+  segment(v, nullptr, t, t_s);
+  return v;
+}
+
+/// Position and velocity after moving from (p, v) at time 0 to time t_s under `phases`.
+void integrate_phases(const std::vector<AccelerationPhase>& phases, double t_s, cv::Vec3d& p,
+                      cv::Vec3d& v) {
+  v = walk_phases(phases, t_s, v,
+                  [&p](const cv::Vec3d& u, const cv::Vec3d* a, double t0, double t1) {
+                    const double span = t1 - t0;
+                    p += a ? u * span + *a * (0.5 * span * span) : u * span;
+                  });
 }
 
 /// The integral over [a, b] of R_y(w tau) (u + k (tau - a)) d tau, w != 0 (R_y as in
@@ -380,9 +393,8 @@ cv::Vec3d box_position(const Box& box, double t_s) {
 }
 
 cv::Vec3d box_velocity(const Box& box, double t_s) {
-  cv::Vec3d p = box.position_m, v = box.velocity_mps;
-  integrate_phases(box.accelerations, t_s, p, v);
-  return v;
+  return walk_phases(box.accelerations, t_s, box.velocity_mps,
+                     [](const cv::Vec3d&, const cv::Vec3d*, double, double) {});
 }
 
 cv::Matx33d camera_rotation(const CameraMotion& m, double t_s) {
@@ -402,9 +414,8 @@ cv::Matx33d camera_rotation(const CameraMotion& m, double t_s) {
 }
 
 cv::Vec3d ego_heading_velocity(const Scenario& s, double t_s) {
-  cv::Vec3d p(0, 0, 0), v = s.ego_velocity_mps;
-  integrate_phases(s.ego_accelerations, t_s, p, v);
-  return v;
+  return walk_phases(s.ego_accelerations, t_s, s.ego_velocity_mps,
+                     [](const cv::Vec3d&, const cv::Vec3d*, double, double) {});
 }
 
 cv::Vec3d ego_velocity(const Scenario& s, double t_s) {
@@ -423,23 +434,21 @@ cv::Vec3d ego_position(const Scenario& s, double t_s) {
     return p;
   }
   // Phase by phase: within one the heading-frame velocity is linear in time.
-  const cv::Vec3d none(0, 0, 0);
-  cv::Vec3d p(0, 0, 0), v = s.ego_velocity_mps;
-  double t = 0.0;
-  const auto& phases = s.ego_accelerations;
-  for (std::size_t i = 0; i < phases.size() && phases[i].from_s < t_s; ++i) {
-    if (phases[i].from_s > t) {
-      p += turned_integral(w, v, none, t, phases[i].from_s);
-      t = phases[i].from_s;
-    }
-    const double end = i + 1 < phases.size() ? std::min(t_s, phases[i + 1].from_s) : t_s;
-    if (end > t) {
-      p += turned_integral(w, v, phases[i].acceleration_mps2, t, end);
-      v += phases[i].acceleration_mps2 * (end - t);
-      t = end;
-    }
-  }
-  return p + turned_integral(w, v, none, t, t_s);
+  cv::Vec3d p(0, 0, 0);
+  walk_phases(s.ego_accelerations, t_s, s.ego_velocity_mps,
+              [&](const cv::Vec3d& u, const cv::Vec3d* a, double t0, double t1) {
+                p += turned_integral(w, u, a ? *a : cv::Vec3d(0, 0, 0), t0, t1);
+              });
+  return p;
+}
+
+cv::Vec3d ego_coasting_position(const Scenario& s, double t_s, double tau_s) {
+  if (s.ego_accelerations.empty()) return ego_position(s, t_s + tau_s);
+  const cv::Vec3d from = ego_position(s, t_s);
+  const double w = yaw_rate_rad(s);
+  if (!s.ego_follows_heading || w == 0.0) return from + ego_velocity(s, t_s) * tau_s;
+  return from +
+         turned_integral(w, ego_heading_velocity(s, t_s), cv::Vec3d(0, 0, 0), t_s, t_s + tau_s);
 }
 
 std::vector<std::string> validate(const Scenario& s) {

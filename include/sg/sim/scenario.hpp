@@ -126,6 +126,10 @@ cv::Vec3d ego_velocity(const Scenario& s, double t_s);
 /// The camera's position at time t_s, world frame, m (the origin at t = 0): the integral of
 /// ego_velocity (closed form, also through a turn).
 cv::Vec3d ego_position(const Scenario& s, double t_s);
+/// Where the camera would be at time t_s + tau_s had it kept from t_s on the velocity it has then
+/// (in the heading's frame, still turning at the yaw rate): the path a time to contact
+/// extrapolates. Without ego_accelerations, ego_position(s, t_s + tau_s).
+cv::Vec3d ego_coasting_position(const Scenario& s, double t_s, double tau_s);
 
 struct Scenario {
   std::string name;
