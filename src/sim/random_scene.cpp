@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "sg/core/platform.hpp"
+#include "sg/sim/renderer.hpp"
 
 namespace sg::sim {
 namespace {
@@ -238,6 +239,9 @@ Scenario random_scenario(std::uint32_t seed, RandomSceneInfo* info_out) {
   s.ground_texture = d.texture();
   s.background_texture = d.texture();
   sample_shadows(d, s);
+  // A camera that has hit something has nothing left to warn of, and the frames after would put
+  // it inside the obstacle: the scene ends at its first contact.
+  s.frames = frames_to_first_contact(s);
   s.description = describe(s, info);
   if (info_out) *info_out = info;
   return s;

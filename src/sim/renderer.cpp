@@ -468,42 +468,56 @@ void blur_and_add_noise(cv::Mat& gray, const cv::Mat& flow, double share, const 
 
 namespace {
 
-/// box_collision for a turning camera: steps the future (box at its current velocity, camera on
-/// its own path and rotation) and checks the box's bounds in the camera frame of each instant.
+/// Whether `box` (at its time-t_s velocity) touches the envelope tau seconds after t_s, seen from
+/// the camera on its path at its current speed and rotated as then (ego accelerations are not
+/// foreseen, as the box's are not): its bounds in that instant's camera frame reach the contact
+/// depth (Z_near <= z_contact, Z_far >= 0) while overlapping the envelope's X and Y extents.
+bool touches_rotated(const Scenario& s, const Box& box, double t_s, double tau) {
+  const core::Envelope& e = s.envelope;
+  const cv::Matx33d to_camera = camera_rotation(s.camera_motion, t_s + tau).t();
+  const cv::Vec3d eye = ego_coasting_position(s, t_s, tau);
+  const cv::Vec3d c = box_position(box, t_s) + box_velocity(box, t_s) * tau;
+  const cv::Vec3d half = box.size_m * 0.5;
+  cv::Vec3d lo(kInf, kInf, kInf), hi(-kInf, -kInf, -kInf);
+  for (int k = 0; k < 8; ++k) {
+    const cv::Vec3d corner(c[0] + ((k & 1) ? half[0] : -half[0]),
+                           c[1] + ((k & 2) ? half[1] : -half[1]),
+                           c[2] + ((k & 4) ? half[2] : -half[2]));
+    const cv::Vec3d q = to_camera * (corner - eye);
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], q[a]);
+      hi[a] = std::max(hi[a], q[a]);
+    }
+  }
+  return lo[2] <= e.z_contact_m && hi[2] >= 0.0 && hi[0] >= -e.half_width_m &&
+         lo[0] <= e.half_width_m && hi[1] >= e.y_top_m && lo[1] <= e.y_bottom_m;
+}
+
+/// box_collision for a rotating camera: steps the future and checks the box's bounds in the
+/// camera frame of each instant (touches_rotated).
 core::ObstacleTruth turning_collision(const Scenario& s, const Box& box, double t_s) {
   constexpr double kStep = 1e-3;  // s
   core::ObstacleTruth o;
   o.id = box.id;
-  const core::Envelope& e = s.envelope;
-  const cv::Vec3d centre = box_position(box, t_s), velocity = box_velocity(box, t_s);
-  const cv::Vec3d half = box.size_m * 0.5;
-  const int steps = static_cast<int>(std::ceil(e.horizon_s / kStep));
+  const double horizon = s.envelope.horizon_s;
+  const int steps = static_cast<int>(std::ceil(horizon / kStep));
   for (int i = 0; i <= steps; ++i) {
-    const double tau = std::min(i * kStep, e.horizon_s);
-    const cv::Matx33d to_camera = camera_rotation(s.camera_motion, t_s + tau).t();
-    // The camera on its path at its current speed (ego accelerations are not foreseen, as the
-    // box's are not).
-    const cv::Vec3d eye = ego_coasting_position(s, t_s, tau);
-    const cv::Vec3d c = centre + velocity * tau;
-    cv::Vec3d lo(kInf, kInf, kInf), hi(-kInf, -kInf, -kInf);
-    for (int k = 0; k < 8; ++k) {
-      const cv::Vec3d corner(c[0] + ((k & 1) ? half[0] : -half[0]),
-                             c[1] + ((k & 2) ? half[1] : -half[1]),
-                             c[2] + ((k & 4) ? half[2] : -half[2]));
-      const cv::Vec3d q = to_camera * (corner - eye);
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = std::min(lo[a], q[a]);
-        hi[a] = std::max(hi[a], q[a]);
-      }
-    }
-    if (lo[2] <= e.z_contact_m && hi[2] >= 0.0 && hi[0] >= -e.half_width_m &&
-        lo[0] <= e.half_width_m && hi[1] >= e.y_top_m && lo[1] <= e.y_bottom_m) {
+    const double tau = std::min(i * kStep, horizon);
+    if (touches_rotated(s, box, t_s, tau)) {
       o.colliding = true;
       o.ttc_s = tau;
       return o;
     }
   }
   return o;
+}
+
+/// Whether `box` touches the platform at t_s: box_collision's verdict "colliding, TTC 0", without
+/// stepping the future.
+bool touches(const Scenario& s, const Box& box, double t_s) {
+  if (s.camera_motion.rotates()) return touches_rotated(s, box, t_s, 0.0);
+  const core::ObstacleTruth o = box_collision(s, box, t_s);
+  return o.colliding && o.ttc_s && *o.ttc_s <= 0.0;
 }
 
 }  // namespace
@@ -538,6 +552,14 @@ core::ObstacleTruth box_collision(const Scenario& s, const Box& box, double t_s)
     o.ttc_s = t_c;
   }
   return o;
+}
+
+int frames_to_first_contact(const Scenario& s) {
+  for (int i = 0; i < s.frames; ++i)
+    for (const Box& b : s.obstacles) {
+      if (touches(s, b, i / s.camera.fps)) return std::max(2, i + 1);
+    }
+  return s.frames;
 }
 
 Renderer::Renderer(Scenario scenario) : scenario_(std::move(scenario)) {

@@ -251,10 +251,12 @@ void LabelJob::conclude() {
   if (flow_mode_ && sf.grow_into_edges)
     grow_danger_into_edges(disparity_, edges_, sf.edge_margin_px, sf.edge_step_px,
                            p.signal.open_size, danger_, ttc_, velocity_);
-  if (flow_mode_ && sf.exclude_ground) {
+  // Only dangerous pixels are cleared, so only they are tested, and a frame without any needs
+  // no plane (the same masks as testing every pixel).
+  if (flow_mode_ && sf.exclude_ground && cv::countNonZero(danger_) > 0) {
     const GroundPlane plane = fit_ground_plane(disparity_, *camera_, sf.ground);
     cv::Mat ground;
-    mark_ground(disparity_, *camera_, plane, sf.ground.tolerance_m, ground);
+    mark_ground(disparity_, *camera_, plane, sf.ground.tolerance_m, ground, danger_);
     danger_.setTo(0, ground);
     ttc_.setTo(std::numeric_limits<float>::quiet_NaN(), ground);
   }

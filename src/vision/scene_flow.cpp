@@ -540,10 +540,23 @@ GroundPlane fit_ground_plane(const cv::Mat& disp, const core::Camera& cam, const
   GroundPlane best;
   if (pts.size() < 3) return best;
   const double kMinUp = std::cos(CV_PI / 4);  // |n_y| >= cos 45 deg: roughly horizontal
-  auto count = [&pts, &p](const cv::Vec3d& n, double c) {
+  // The points by coordinate, so that the inlier count is a tight loop over arrays.
+  const std::size_t n_pts = pts.size();
+  std::vector<double> xs(n_pts), ys(n_pts), zs(n_pts);
+  for (std::size_t i = 0; i < n_pts; ++i) xs[i] = pts[i].x, ys[i] = pts[i].y, zs[i] = pts[i].z;
+  // Inliers of the plane n.P + c = 0; stops once even all the points left could not make more
+  // than `beat` (the count returned is then at most `beat`).
+  auto count = [&](const cv::Vec3d& n, double c, int beat) {
     int inliers = 0;
-    for (const auto& P : pts)
-      if (std::abs(n.dot(cv::Vec3d(P)) + c) <= p.tolerance_m) ++inliers;
+    constexpr std::size_t kBlock = 256;
+    for (std::size_t i0 = 0; i0 < n_pts; i0 += kBlock) {
+      const std::size_t i1 = std::min(n_pts, i0 + kBlock);
+      int in_block = 0;
+      for (std::size_t i = i0; i < i1; ++i)
+        in_block += std::abs(n[0] * xs[i] + n[1] * ys[i] + n[2] * zs[i] + c) <= p.tolerance_m;
+      inliers += in_block;
+      if (inliers + static_cast<int>(n_pts - i1) <= beat) return inliers;
+    }
     return inliers;
   };
   std::mt19937_64 rng(p.seed);
@@ -556,7 +569,7 @@ GroundPlane fit_ground_plane(const cv::Mat& disp, const core::Camera& cam, const
     n /= len;
     if (n[1] > 0) n = -n;  // point up (y down)
     if (-n[1] < kMinUp) continue;
-    const int inliers = count(n, -n.dot(a));
+    const int inliers = count(n, -n.dot(a), best.inliers);
     if (inliers > best.inliers) best = {n, -n.dot(a), inliers, false};
   }
   if (best.inliers < std::max(3, p.min_inliers)) return GroundPlane{};
@@ -576,23 +589,26 @@ GroundPlane fit_ground_plane(const cv::Mat& disp, const core::Camera& cam, const
   if (-n[1] >= kMinUp) {
     best.normal = n;
     best.offset = -n.dot(mean);
-    best.inliers = count(best.normal, best.offset);
+    best.inliers = count(best.normal, best.offset, -1);
   }
   best.found = best.inliers >= p.min_inliers;
   return best;
 }
 
 void mark_ground(const cv::Mat& disp, const core::Camera& cam, const GroundPlane& plane,
-                 double tolerance_m, cv::Mat& mask) {
+                 double tolerance_m, cv::Mat& mask, const cv::Mat& only) {
   if (disp.type() != CV_32FC1) throw core::InputError("ground mask: disparity must be CV_32F");
+  if (!only.empty() && (only.type() != CV_8UC1 || only.size() != disp.size()))
+    throw core::InputError("ground mask: `only` must be CV_8U of the disparity's size");
   mask.create(disp.size(), CV_8UC1);
   mask.setTo(0);
   if (!plane.found) return;
   for (int y = 0; y < disp.rows; ++y) {
     const float* row = disp.ptr<float>(y);
+    const uint8_t* wanted = only.empty() ? nullptr : only.ptr<uint8_t>(y);
     uint8_t* out = mask.ptr<uint8_t>(y);
     for (int x = 0; x < disp.cols; ++x) {
-      if (!(row[x] > 0.0f)) continue;
+      if (!(row[x] > 0.0f) || (wanted && !wanted[x])) continue;
       const cv::Point3d P = cam.point(x, y, row[x]);
       if (plane.normal.dot(cv::Vec3d(P)) + plane.offset <= tolerance_m) out[x] = 255;
     }

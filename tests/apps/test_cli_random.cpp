@@ -53,6 +53,14 @@ TEST_F(CliRandom, SimulatedSceneIsScoredByEval) {
   ASSERT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(sg::test::slurp(dir_ / "scene" / "gt" / "frames.jsonl"),
             sg::test::slurp(dir_ / "scene2" / "gt" / "frames.jsonl"));
+  // The scene's own scenario.yaml renders it again.
+  ASSERT_TRUE(fs::exists(dir_ / "scene" / "scenario.yaml"));
+  const Result replay = run("simulate --scenario scene/scenario.yaml --out scene3");
+  ASSERT_EQ(replay.status, 0) << replay.err;
+  EXPECT_EQ(sg::test::slurp(dir_ / "scene" / "gt" / "frames.jsonl"),
+            sg::test::slurp(dir_ / "scene3" / "gt" / "frames.jsonl"));
+  EXPECT_EQ(sg::test::slurp(dir_ / "scene" / "left" / "000011.png"),
+            sg::test::slurp(dir_ / "scene3" / "left" / "000011.png"));
   const Result eval = run("eval --input scene --json e.json");
   ASSERT_EQ(eval.status, 0) << eval.err;
   const nlohmann::json j = nlohmann::json::parse(sg::test::slurp(dir_ / "e.json"));

@@ -43,7 +43,7 @@ TEST(RandomScene, DifferentSeedsDiffer) {
 TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
   const RandomSceneRanges& r = kRandomSceneRanges;
   std::set<std::string> platforms, shapes, paths, motions;
-  int with_jpeg = 0, clear = 0, with_shadows = 0;
+  int with_jpeg = 0, clear = 0, with_shadows = 0, ended_at_contact = 0;
   std::set<TextureKind> textures;
   for (std::uint32_t seed = 1000; seed < 1500; ++seed) {
     RandomSceneInfo info;
@@ -56,7 +56,16 @@ TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
     EXPECT_TRUE(within(2.0 * std::atan(0.5 * c.width / c.focal_px) / kDeg, r.fov_deg, 1e-6));
     EXPECT_TRUE(within(c.baseline_m, r.baseline_m));
     EXPECT_TRUE(within(c.fps, r.fps));
-    EXPECT_TRUE(within(s.frames / c.fps, r.duration_s, 1.0 / c.fps));
+    // The drawn length, or shorter where an obstacle touches the platform (its last frame).
+    EXPECT_LE(s.frames / c.fps, r.duration_s.hi + 1.0 / c.fps);
+    if (s.frames / c.fps < r.duration_s.lo - 1.0 / c.fps) {
+      const double last = (s.frames - 1) / c.fps;
+      EXPECT_TRUE(std::any_of(s.obstacles.begin(), s.obstacles.end(), [&](const Box& b) {
+        const core::ObstacleTruth o = box_collision(s, b, last);
+        return o.colliding && o.ttc_s && *o.ttc_s == 0.0;
+      }));
+      ++ended_at_contact;
+    }
     const auto p =
         static_cast<std::size_t>(std::find_if(kRandomPlatforms.begin(), kRandomPlatforms.end(),
                                               [&](const char* n) { return info.platform == n; }) -
@@ -71,7 +80,6 @@ TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
     if (info.ego_motion == "forward") {
       EXPECT_TRUE(within(speed, r.ego_speed_mps[p]));
     }
-    const double duration = s.frames / c.fps;
     if (info.ego_motion == "accelerating") {
       // Reaches its full speed after the ramp, from a share of it.
       const double full = ego_velocity(s, r.speed_ramp_s.hi + 0.1)[2];
@@ -79,8 +87,11 @@ TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
       EXPECT_LE(speed, r.start_speed_share.hi * full + 1e-9);
     } else if (info.ego_motion == "stopping") {
       EXPECT_TRUE(within(speed, r.ego_speed_mps[p]));
-      EXPECT_NEAR(ego_velocity(s, duration * r.brake_start_share.hi + r.brake_ramp_s.hi)[2], 0.0,
-                  1e-9);
+      // Brakes within the drawn length (the scene may end sooner, at a contact) to a standstill.
+      ASSERT_EQ(s.ego_accelerations.size(), 2u);
+      const double stopped_s = s.ego_accelerations.back().from_s;
+      EXPECT_LE(stopped_s, r.duration_s.hi * r.brake_start_share.hi + r.brake_ramp_s.hi);
+      EXPECT_NEAR(ego_velocity(s, stopped_s + 1e-6)[2], 0.0, 1e-9);
     } else {
       EXPECT_TRUE(s.ego_accelerations.empty());
     }
@@ -153,6 +164,7 @@ TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
   EXPECT_GT(with_jpeg, 150);
   EXPECT_GT(with_shadows, 120);
   EXPECT_GT(clear, 50);
+  EXPECT_GT(ended_at_contact, 50);
 }
 
 TEST(RandomScene, CapKeepsTheFieldOfViewAndShortens) {

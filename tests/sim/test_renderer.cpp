@@ -177,6 +177,24 @@ TEST(Renderer, CrossingRecedingAndBesideDoNotCollide) {
   EXPECT_NEAR(*box_collision(s, still, 0.5).ttc_s, (5.0 - 1.0 - 0.5) / 2.0, 1e-12);
 }
 
+TEST(Renderer, FramesToFirstContactEndAtTheFrameTheBoxTouches) {
+  Scenario s = builtin_scenario("head-on");
+  s.frames = 200;
+  // Z_near(t) = 14.75 - 3 t reaches the contact depth 0.5 m at t = 4.75 s: frame 142.5, so
+  // frame 143 (t = 4.767 s) is the first in contact and the scene keeps 144 frames.
+  EXPECT_EQ(frames_to_first_contact(s), 144);
+  // A swaying camera takes the rotating path; the box still touches at frame 143.
+  s.camera_motion.pitch_amplitude_deg = 0.5;
+  s.camera_motion.oscillation_hz = 1.0;
+  ASSERT_TRUE(s.camera_motion.rotates());
+  EXPECT_EQ(frames_to_first_contact(s), 144);
+  // A shorter scene, and one whose box passes beside, keep their frames.
+  s.frames = 100;
+  EXPECT_EQ(frames_to_first_contact(s), 100);
+  Scenario beside = builtin_scenario("ego-pass");
+  EXPECT_EQ(frames_to_first_contact(beside), beside.frames);
+}
+
 TEST(Renderer, DangerMaskAndAlarmFollowTheCollidingBox) {
   Scenario s = small("two-obstacles");
   const Renderer r(s);

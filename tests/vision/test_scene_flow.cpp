@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -921,6 +923,61 @@ TEST(LabelStereoFlow, EnvelopeBandKeepsGroundPointsOut) {
 // ---------------------------------------------------------------------------------------------
 // Ground plane
 
+/// fit_ground_plane as a plain loop: every hypothesis counted over every point, then the same
+/// least-squares refit.
+GroundPlane fit_ground_plane_reference(const cv::Mat& disp, const core::Camera& cam,
+                                       const GroundParams& p) {
+  std::vector<cv::Point3d> pts;
+  const int y0 = disp.rows - std::max(1, static_cast<int>(disp.rows * p.lower_fraction));
+  for (int y = y0; y < disp.rows; y += p.sample_step_px)
+    for (int x = 0; x < disp.cols; x += p.sample_step_px) {
+      const float d = disp.at<float>(y, x);
+      if (!(d > 0.0f)) continue;
+      const cv::Point3d P = cam.point(x, y, d);
+      if (P.z <= p.z_max_m) pts.push_back(P);
+    }
+  const auto count = [&](const cv::Vec3d& n, double c) {
+    int inliers = 0;
+    for (const auto& P : pts) inliers += std::abs(n.dot(cv::Vec3d(P)) + c) <= p.tolerance_m;
+    return inliers;
+  };
+  GroundPlane best;
+  std::mt19937_64 rng(p.seed);
+  std::uniform_int_distribution<size_t> pick(0, pts.size() - 1);
+  for (int it = 0; it < p.iterations; ++it) {
+    const cv::Vec3d a(pts[pick(rng)]), b(pts[pick(rng)]), c(pts[pick(rng)]);
+    cv::Vec3d n = (b - a).cross(c - a);
+    const double len = cv::norm(n);
+    if (len < 1e-9) continue;
+    n /= len;
+    if (n[1] > 0) n = -n;
+    if (-n[1] < std::cos(CV_PI / 4)) continue;
+    const int inliers = count(n, -n.dot(a));
+    if (inliers > best.inliers) best = {n, -n.dot(a), inliers, false};
+  }
+  if (best.inliers < std::max(3, p.min_inliers)) return GroundPlane{};
+  cv::Vec3d mean(0, 0, 0);
+  std::vector<cv::Vec3d> in;
+  for (const auto& P : pts)
+    if (std::abs(best.normal.dot(cv::Vec3d(P)) + best.offset) <= p.tolerance_m) in.emplace_back(P);
+  for (const auto& P : in) mean += P;
+  mean /= static_cast<double>(in.size());
+  cv::Matx33d cov = cv::Matx33d::zeros();
+  for (const auto& P : in) cov += (P - mean) * (P - mean).t();
+  cv::Mat evals, evecs;
+  cv::eigen(cov, evals, evecs);
+  cv::Vec3d n(evecs.at<double>(2, 0), evecs.at<double>(2, 1), evecs.at<double>(2, 2));
+  if (n[1] > 0) n = -n;
+  if (-n[1] >= std::cos(CV_PI / 4)) {
+    best.normal = n;
+    best.offset = -n.dot(mean);
+    best.inliers = count(best.normal, best.offset);
+  }
+  best.found = best.inliers >= p.min_inliers;
+  return best;
+}
+
+
 TEST(GroundPlane, FitsATiltedGroundAndSparesAnObstacle) {
   core::Camera cam = odd_camera();
   const double h = 1.0, pitch = 10.0 * CV_PI / 180.0;
@@ -965,6 +1022,18 @@ TEST(GroundPlane, FitsATiltedGroundAndSparesAnObstacle) {
   const GroundPlane again = fit_ground_plane(disp, cam, GroundParams{});
   EXPECT_EQ(again.normal, g.normal);
   EXPECT_EQ(again.offset, g.offset);
+  // Counts that stop early pick the plane the plain loop picks, bit for bit.
+  const GroundPlane reference = fit_ground_plane_reference(disp, cam, GroundParams{});
+  EXPECT_EQ(reference.normal, g.normal);
+  EXPECT_EQ(reference.offset, g.offset);
+  EXPECT_EQ(reference.inliers, g.inliers);
+  // Testing only some pixels marks those of them the full mask marks.
+  cv::Mat only(disp.size(), CV_8U, cv::Scalar(0)), part, expected;
+  only(cv::Rect(0, cam.height / 2, cam.width / 2, cam.height / 2)).setTo(255);
+  mark_ground(disp, cam, g, 0.05, part, only);
+  cv::bitwise_and(mask, only, expected);
+  EXPECT_EQ(cv::countNonZero(part != expected), 0);
+  EXPECT_GT(cv::countNonZero(part), 100);
 }
 
 TEST(GroundPlane, NoPlaneWithoutPoints) {

@@ -78,10 +78,10 @@ struct BmParams {
   /// away, and the simulated ego-pass raised 3 false alarm frames, none with the check.
   int lr_max_diff = 1;
   /// Match the left band too (vision/left_band.hpp): the columns the full range cannot search,
-  /// strip by strip with the range that fits (bm, sgbm and fast; longseq ignores it). Off: a
-  /// near point whose disparity exceeds its strip's range aliases to a wrong one
+  /// strip by strip with the range that fits (bm, sgbm and fast; longseq ignores it). Off leaves
+  /// them unmatched: with a wide baseline or a near contact that is a third to half of the image
   /// (docs/decisions/left-band.md).
-  bool left_band = false;
+  bool left_band = true;
   // LongSeq (matcher longseq): its window is one row of block_size pixels (<= 63), its disparities
   // 0 .. num_disparities - 1 (min_disparity 0).
   double longseq_cost_max = 6.0;  ///< a good match: mean absolute difference <= this, grey levels
@@ -316,8 +316,10 @@ struct SceneFlowParams {
   /// The point must lie in the envelope's vertical band now too (y_top <= Y_i <= y_bottom), as in
   /// Stereo mode: ground and overhead points then cannot enter the envelope through noise in V_y.
   bool use_envelope_band = true;
-  /// Clear dangerous pixels on or below a fitted ground plane (for tilted cameras).
-  bool exclude_ground = false;
+  /// Clear dangerous pixels on or below a fitted ground plane: the ground is never an obstacle,
+  /// yet an envelope that reaches below the camera's height (a robot preset 1.0 m deep on a
+  /// camera 0.5 m high), a tilt, or flow lost on a fast road make it read as approaching.
+  bool exclude_ground = true;
   GroundParams ground;  ///< the fit used by exclude_ground
 };
 

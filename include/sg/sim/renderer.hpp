@@ -28,6 +28,10 @@ struct RenderedFrame {
 /// already touch.
 core::ObstacleTruth box_collision(const Scenario& s, const Box& box, double t_s);
 
+/// The frames of `s` up to and including the first at which an obstacle touches the platform
+/// (box_collision colliding with TTC 0), else s.frames; at least 2.
+int frames_to_first_contact(const Scenario& s);
+
 /// Pure function of (scenario, frame index): rendering frame i never depends on other frames.
 /// Pixel (x, y) looks along R(t) ((x - cx) / f, (y - cy) / f, 1) (R = camera_rotation); its gray
 /// level is that ray's shade, or, where the surface it hits differs from a 4-neighbour's, the mean

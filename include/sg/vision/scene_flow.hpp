@@ -173,8 +173,9 @@ GroundPlane fit_ground_plane(const cv::Mat& disp, const core::Camera& cam, const
 
 /// 255 where the pixel's 3D point lies within `tolerance_m` of the plane or below it (under the
 /// ground), 0 elsewhere and where the disparity is invalid. Clear `danger` with it to exclude the
-/// ground when the camera is tilted. mask: CV_8U, allocated.
+/// ground when the camera is tilted. mask: CV_8U, allocated. With `only` (CV_8U, the
+/// disparity's size) just its nonzero pixels are tested; the others stay 0.
 void mark_ground(const cv::Mat& disp, const core::Camera& cam, const GroundPlane& plane,
-                 double tolerance_m, cv::Mat& mask);
+                 double tolerance_m, cv::Mat& mask, const cv::Mat& only = cv::Mat());
 
 }  // namespace sg::vision
