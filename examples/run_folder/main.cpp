@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
   try {
     sg::io::FolderSource source(argv[1]);
 
-    sg::pipeline::RunOptions options;  // defaults of `stereoguard run`
+    sg::pipeline::RunOptions options;  // Stereo mode unless argv[2] names one (run: stereo-flow)
     if (argc == 3) options.params.mode = sg::core::parse_mode(argv[2]);
     options.workers = 2;  // two frames' stereo matching at once
 

@@ -240,7 +240,7 @@ struct SceneFlowParams {
   double edge_step_px = 1.0;
   /// Give back thin near structures (poles, posts, bars) that the edge margin would remove
   /// whole: pixels of a run of similar disparity at most 2 edge_margin_px + 1 long between
-  /// farther surfaces, with nothing nearer within the margin (vision/thin_structures.hpp), are
+  /// farther surfaces, with nothing nearer within the margin (vision/edge_margin.hpp), are
   /// not depth-edge pixels. Without it a 6 cm pole is missed until 2 m away (simulated thin-pole).
   bool keep_thin_structures = true;
   /// Pool the velocity over each surface before the envelope test (vision/segment_motion.hpp):

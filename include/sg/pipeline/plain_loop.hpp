@@ -3,7 +3,7 @@
 /// StereoBM, DIS ultrafast in Stereo-Flow mode, then the detector's labelling, obstacles and
 /// signals. No skeleton, no threads of its own: OpenCV's parallel loops run with whatever thread
 /// count the process has (cv::setNumThreads). The baseline rows of `bench` and the whole-process
-/// baseline (bench/plain_loop) both run it.
+/// baseline (the plain_loop program, src/apps/plain_loop.cpp) both run it.
 #include <opencv2/calib3d.hpp>
 #include <opencv2/video/tracking.hpp>
 
