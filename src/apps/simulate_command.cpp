@@ -1,6 +1,5 @@
 // `stereoguard simulate`: renders a scenario into a stereo folder with its ground truth.
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <limits>
 
@@ -62,10 +61,7 @@ void simulate_main(const SimulateArgs& args) {
     alarms += r.truth.alarm ? 1 : 0;
   }
   // The scene itself beside its frames: `simulate --scenario` and `eval --scenario` replay it.
-  const std::filesystem::path yaml = std::filesystem::path(args.out) / "scenario.yaml";
-  std::ofstream file(yaml);
-  file << sim::to_yaml(scenario);
-  if (!file.flush()) throw core::InputError("cannot write " + yaml.string());
+  sim::save_scenario_file(scenario, (std::filesystem::path(args.out) / "scenario.yaml").string());
   std::cout << "wrote " << writer.frames_written() << " frames of '" << scenario.name << "' to "
             << args.out << " (" << alarms << " ground-truth alarm frames) and its scenario.yaml\n";
   if (args.random) std::cout << scenario.description << "\n";

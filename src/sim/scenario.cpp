@@ -712,7 +712,7 @@ std::string to_yaml(const Scenario& s) {
 void save_scenario_file(const Scenario& s, const std::string& path) {
   std::ofstream out(path);
   out << to_yaml(s);
-  if (!out) throw core::InputError(path + ": cannot write scenario file");
+  if (!out.flush()) throw core::InputError(path + ": cannot write scenario file");
 }
 
 }  // namespace sg::sim
