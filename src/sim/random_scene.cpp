@@ -195,6 +195,20 @@ void sample_shadows(Draw& d, Scenario& s) {
   }
 }
 
+/// Whether boxes a and b overlap at some frame time of the first `duration_s` seconds (frames at
+/// `fps`): solid obstacles do not pass through each other, and one that would is left out.
+bool overlap_in_scene(const Box& a, const Box& b, double duration_s, double fps) {
+  const int frames = static_cast<int>(std::ceil(duration_s * fps));
+  for (int i = 0; i <= frames; ++i) {
+    const double t = i / fps;
+    const cv::Vec3d gap = box_position(a, t) - box_position(b, t);
+    bool apart = false;
+    for (int k = 0; k < 3; ++k) apart |= std::abs(gap[k]) >= 0.5 * (a.size_m[k] + b.size_m[k]);
+    if (!apart) return true;
+  }
+  return false;
+}
+
 std::string describe(const Scenario& s, const RandomSceneInfo& info) {
   std::ostringstream out;
   out << info.platform << ", " << s.camera.width << "x" << s.camera.height << ", "
@@ -227,8 +241,16 @@ Scenario random_scenario(std::uint32_t seed, RandomSceneInfo* info_out) {
   const int count = d.index(r.max_obstacles + 1);
   double far_z = 0.0;
   for (int i = 0; i < count; ++i) {
-    s.obstacles.push_back(sample_obstacle(d, platform, s, duration_s, i + 1, info));
-    const Box& b = s.obstacles.back();
+    const int id = static_cast<int>(s.obstacles.size()) + 1;
+    RandomSceneInfo drawn = info;
+    Box b = sample_obstacle(d, platform, s, duration_s, id, drawn);
+    // The draws are made either way, so that leaving an obstacle out changes nothing else.
+    if (std::any_of(s.obstacles.begin(), s.obstacles.end(), [&](const Box& other) {
+          return overlap_in_scene(b, other, duration_s, s.camera.fps);
+        }))
+      continue;
+    info = std::move(drawn);
+    s.obstacles.push_back(b);
     far_z = std::max(
         far_z, b.position_m[2] + 0.5 * b.size_m[2] + std::max(0.0, b.velocity_mps[2]) * duration_s);
   }

@@ -167,6 +167,37 @@ TEST(RandomScene, EveryDrawLiesInItsRangeAndTheSceneIsValid) {
   EXPECT_GT(ended_at_contact, 50);
 }
 
+// Solid obstacles never pass through each other: at every frame of every scene, each pair is
+// apart along some axis. Their ids stay 1..n, in the order the description lists them.
+TEST(RandomScene, NoTwoObstaclesOverlapAtAnyFrame) {
+  int pairs = 0, four = 0;
+  for (std::uint32_t seed = 1000; seed < 1500; ++seed) {
+    RandomSceneInfo info;
+    const Scenario s = random_scenario(seed, &info);
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    ASSERT_EQ(info.shapes.size(), s.obstacles.size());
+    four += s.obstacles.size() == 4 ? 1 : 0;
+    for (std::size_t i = 0; i < s.obstacles.size(); ++i) {
+      EXPECT_EQ(s.obstacles[i].id, static_cast<int>(i) + 1);
+      for (std::size_t j = 0; j < i; ++j) {
+        const Box &a = s.obstacles[i], &b = s.obstacles[j];
+        ++pairs;
+        for (int f = 0; f < s.frames; ++f) {
+          const double t = f / s.camera.fps;
+          const cv::Vec3d gap = box_position(a, t) - box_position(b, t);
+          const bool apart = std::abs(gap[0]) >= 0.5 * (a.size_m[0] + b.size_m[0]) ||
+                             std::abs(gap[1]) >= 0.5 * (a.size_m[1] + b.size_m[1]) ||
+                             std::abs(gap[2]) >= 0.5 * (a.size_m[2] + b.size_m[2]);
+          ASSERT_TRUE(apart) << "obstacles " << a.id << " and " << b.id << " meet at frame " << f;
+        }
+      }
+    }
+  }
+  // Scenes still hold several obstacles: 0-4 are drawn, and only those that would meet go.
+  EXPECT_GT(pairs, 300);
+  EXPECT_GT(four, 10);
+}
+
 TEST(RandomScene, CapKeepsTheFieldOfViewAndShortens) {
   Scenario s = random_scenario(7);
   const double fov = std::atan(0.5 * s.camera.width / s.camera.focal_px);

@@ -57,7 +57,8 @@ struct RandomSceneRanges {
   SampleRange pitch_amplitude_deg{0.0, 3.0};
   SampleRange roll_amplitude_deg{0.0, 3.0};
   SampleRange sway_hz{0.5, 2.5};
-  int max_obstacles = 4;  ///< 0..max_obstacles, uniform
+  /// 0..max_obstacles drawn, uniform; one whose box meets an earlier one's is left out.
+  int max_obstacles = 4;
   /// Width (X), height (Y), depth (Z) per shape, indexed like kRandomShapes, m.
   std::array<std::array<SampleRange, 3>, 6> shape_size_m{{
       {{{0.3, 1.0}, {0.3, 1.2}, {0.3, 1.0}}},    // box
