@@ -172,9 +172,32 @@ Distribution distribution(std::vector<double> values) {
   return d;
 }
 
+namespace {
+
+RandomSceneTraits scene_traits(const sim::Scenario& s, const sim::RandomSceneInfo& info) {
+  const std::vector<std::string>& texture = sim::texture_kind_names();
+  RandomSceneTraits t;
+  t.ego_motion = info.ego_motion;
+  t.focal_baseline_px_m = s.camera.focal_px * s.camera.baseline_m;
+  t.noise_sigma = s.noise_sigma;
+  t.jpeg_quality = s.effects.jpeg_quality;
+  t.exposure_ms = s.effects.exposure_time_s * 1e3;
+  t.shadow_casters = static_cast<int>(s.shadows.casters.size());
+  t.ground_texture = texture[static_cast<std::size_t>(s.ground_texture)];
+  t.background_texture = texture[static_cast<std::size_t>(s.background_texture)];
+  t.shapes = info.shapes;
+  t.paths = info.paths;
+  for (const sim::Box& b : s.obstacles)
+    t.textures.push_back(texture[static_cast<std::size_t>(b.texture)]);
+  return t;
+}
+
+}  // namespace
+
 RandomSceneResult score_random_scene(std::uint32_t seed, const RandomSuiteOptions& options) {
   const Clock::time_point start = Clock::now();
-  sim::Scenario scenario = sim::random_scenario(seed);
+  sim::RandomSceneInfo info;
+  sim::Scenario scenario = sim::random_scenario(seed, &info);
   sim::cap_scenario(scenario, options.max_size, options.max_frames);
   RunOptions run_options =
       make_run_options(options.detector, scenario.platform, nullptr, &scenario.camera);
@@ -191,6 +214,7 @@ RandomSceneResult score_random_scene(std::uint32_t seed, const RandomSuiteOption
   r.height = scenario.camera.height;
   r.frames = scenario.frames;
   r.fps = scenario.camera.fps;
+  r.traits = scene_traits(scenario, info);
   sim::ScenarioSource source(scenario);
   std::vector<char> gt_alarm(static_cast<std::size_t>(scenario.frames), 0);
   std::vector<char> fired(gt_alarm.size(), 0);
@@ -261,6 +285,18 @@ nlohmann::json RandomSuiteResult::to_json() const {
     row["height"] = r.height;
     row["frames"] = r.frames;
     row["fps"] = r.fps;
+    const RandomSceneTraits& t = r.traits;
+    row["scene"] = {{"ego_motion", t.ego_motion},
+                    {"focal_baseline_px_m", t.focal_baseline_px_m},
+                    {"noise_sigma", t.noise_sigma},
+                    {"jpeg_quality", t.jpeg_quality},
+                    {"exposure_ms", t.exposure_ms},
+                    {"shadow_casters", t.shadow_casters},
+                    {"ground_texture", t.ground_texture},
+                    {"background_texture", t.background_texture},
+                    {"shapes", t.shapes},
+                    {"paths", t.paths},
+                    {"textures", t.textures}};
     row["colliding"] = r.colliding();
     row["lead_s"] = optional_json(r.lead_s);
     row["lead_entering_s"] = optional_json(r.lead_entering_s);

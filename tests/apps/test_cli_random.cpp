@@ -91,6 +91,20 @@ TEST_F(CliRandom, SmokeSuiteWritesFiniteFigures) {
     EXPECT_LE(scene.at("frames").get<int>(), 40);
     EXPECT_TRUE(finite_number(scene.at("recall_settled")));
     EXPECT_TRUE(finite_number(scene.at("false_alarm_rate")));
+    // What the scene drew, beside its description: the same motion, shapes and paths.
+    const nlohmann::json& drawn = scene.at("scene");
+    const std::string description = scene.at("description").get<std::string>();
+    EXPECT_NE(description.find(", " + drawn.at("ego_motion").get<std::string>() + " at "),
+              std::string::npos)
+        << description;
+    const auto shapes = drawn.at("shapes").get<std::vector<std::string>>();
+    const auto paths = drawn.at("paths").get<std::vector<std::string>>();
+    ASSERT_EQ(paths.size(), shapes.size());
+    EXPECT_EQ(drawn.at("textures").size(), shapes.size());
+    EXPECT_EQ(shapes.empty(), description.find("no obstacle") != std::string::npos);
+    for (std::size_t k = 0; k < shapes.size(); ++k)
+      EXPECT_NE(description.find(shapes[k] + " " + paths[k]), std::string::npos) << description;
+    EXPECT_GT(drawn.at("focal_baseline_px_m").get<double>(), 0.0);
     // The lead over the obstacles entering the horizon in view is a minimum over a subset of
     // those of lead_s: never below it, and only where there are such obstacles.
     const int entering = scene.at("entering").get<int>();

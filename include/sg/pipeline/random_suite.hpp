@@ -29,12 +29,27 @@ struct RandomSuiteOptions {
 std::vector<std::string> validate(const RandomSuiteOptions& options);
 
 /// One scene's score.
+/// What a scene drew that its description leaves out, for breaking the suite's figures down by
+/// cause (scripts/suite_breakdown.py reads them from the JSON).
+struct RandomSceneTraits {
+  std::string ego_motion;           ///< one of sim::kRandomEgoMotions
+  double focal_baseline_px_m = 0;   ///< f B: the disparity of a point 1 m away, px
+  double noise_sigma = 0;           ///< gray levels
+  int jpeg_quality = 0;             ///< 0 = no compression
+  double exposure_ms = 0;           ///< motion blur's exposure time
+  int shadow_casters = 0;
+  std::string ground_texture, background_texture;  ///< sim::texture_kind_names()
+  /// Per obstacle left in the scene: shape, path and surface texture.
+  std::vector<std::string> shapes, paths, textures;
+};
+
 struct RandomSceneResult {
   std::uint32_t seed = 0;
   std::string description;  ///< sim::random_scenario's
   std::string platform;     ///< the detector preset it ran with
   int width = 0, height = 0, frames = 0;
   double fps = 0.0;
+  RandomSceneTraits traits;
   eval::DetectionReport report;
   /// Ground truth has alarm frames (a colliding scene); else a clear scene.
   bool colliding() const { return report.gt_alarm_frames > 0; }
