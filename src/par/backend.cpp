@@ -4,6 +4,8 @@
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include <optional>
+
 namespace sg::par {
 
 const char* to_string(Backend backend) {
@@ -14,12 +16,6 @@ const char* to_string(Backend backend) {
       return "tbb";
   }
   return "?";
-}
-
-std::optional<Backend> parse_backend(std::string_view text) {
-  if (text == "sequential") return Backend::kSequential;
-  if (text == "tbb") return Backend::kTbb;
-  return std::nullopt;
 }
 
 int default_threads() {

@@ -23,13 +23,6 @@ RowRange tile_rows(int rows, int tiles, int t) {
   return {begin, begin + base + (t < extra ? 1 : 0)};
 }
 
-RowRange with_halo(RowRange range, int halo, int rows) {
-  const int h = std::max(halo, 0);
-  const int begin = std::clamp(range.begin - h, 0, std::max(rows, 0));
-  const int end = std::clamp(range.end + h, begin, std::max(rows, 0));
-  return {begin, end};
-}
-
 void parallel_for_tiles(int rows, int tiles, const TileBody& body, Backend backend) {
   const int count = tile_count(rows, tiles);
   if (count == 0) return;

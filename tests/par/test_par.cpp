@@ -745,10 +745,9 @@ TEST(FarmConfigTest, RunRejectsInvalidConfig) {
   }
 }
 
-TEST(BackendTest, ParseAndPrint) {
-  for (Backend b : {Backend::kSequential, Backend::kTbb}) EXPECT_EQ(parse_backend(to_string(b)), b);
-  EXPECT_EQ(parse_backend("openmp"), std::nullopt);
-  EXPECT_EQ(parse_backend(""), std::nullopt);
+TEST(BackendTest, NamesAndThreads) {
+  EXPECT_STREQ(to_string(Backend::kSequential), "sequential");
+  EXPECT_STREQ(to_string(Backend::kTbb), "tbb");
   EXPECT_GE(default_threads(), 1);
 }
 
@@ -789,17 +788,6 @@ TEST(TilesTest, TileRowsExamples) {
   EXPECT_EQ(tile_rows(5, 0, 0), (RowRange{0, 5}));
   EXPECT_TRUE(tile_rows(10, 3, 3).empty());  // out-of-range tile index
   EXPECT_EQ(tile_count(0, 4), 0);
-}
-
-TEST(TilesTest, WithHaloClamps) {
-  EXPECT_EQ(with_halo({10, 20}, 3, 100), (RowRange{7, 23}));
-  EXPECT_EQ(with_halo({0, 20}, 5, 100), (RowRange{0, 25}));
-  EXPECT_EQ(with_halo({2, 20}, 5, 100), (RowRange{0, 25}));
-  EXPECT_EQ(with_halo({90, 100}, 5, 100), (RowRange{85, 100}));
-  EXPECT_EQ(with_halo({96, 99}, 5, 99), (RowRange{91, 99}));
-  EXPECT_EQ(with_halo({0, 7}, 50, 7), (RowRange{0, 7}));
-  EXPECT_EQ(with_halo({4, 6}, 0, 7), (RowRange{4, 6}));
-  EXPECT_EQ(with_halo({4, 6}, -2, 7), (RowRange{4, 6}));
 }
 
 struct TileCase {

@@ -1,15 +1,15 @@
 #pragma once
 /// Parameters of the detectors the thesis surveys (chapter 3, DESIGN 3.4), beside ours: plain
 /// aggregates with defaults, units in the comments, validated by name like params.hpp. The kernels
-/// that use them live in sg::vision (motion_parallax.hpp, relative_size.hpp, elevation_map.hpp,
-/// sceneflow_seg.hpp, longseq.hpp) and the labelling around them in vision/surveyed.hpp.
+/// that use them live in sg::vision (relative_size.hpp, elevation_map.hpp, sceneflow_seg.hpp,
+/// longseq.hpp) and the labelling around them in vision/surveyed.hpp.
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace sg::core {
 
-/// Motion parallax (vision/motion_parallax.hpp, vision/surveyed.hpp): moving blobs of the flow
+/// Motion parallax (vision/surveyed.hpp): moving blobs of the flow
 /// and the expansion rate of each.
 struct MotionParallaxParams {
   /// The flow is averaged over a box of this side before anything else, px, odd, 1..63.

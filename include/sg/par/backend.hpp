@@ -2,8 +2,6 @@
 /// The runtime that executes the skeletons of sg::par (DESIGN.md section 1): a plain sequential
 /// loop, the reference for correctness, or oneTBB. No TBB type appears in this layer's headers.
 #include <functional>
-#include <optional>
-#include <string_view>
 
 namespace sg::par {
 
@@ -16,8 +14,6 @@ enum class Backend {
 
 /// "sequential" / "tbb".
 const char* to_string(Backend backend);
-/// Parses "sequential" / "tbb"; nullopt for anything else.
-std::optional<Backend> parse_backend(std::string_view text);
 
 /// Number of threads oneTBB uses when none is given (the cores this process may use), >= 1.
 int default_threads();

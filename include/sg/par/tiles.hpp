@@ -1,8 +1,8 @@
 #pragma once
 /// Row tiling, the data-parallel skeleton of DESIGN.md section 1 (FastFlow's parallel-for): a task
 /// of H rows is split into T contiguous horizontal tiles computed independently. A tile of rows
-/// [b, e) may read rows with_halo({b, e}, h, H) and writes only [b, e), so tiled output can equal
-/// untiled output bit for bit. Knows nothing about images.
+/// [b, e) may read the rows its kernel needs around them (h rows above and below, clamped to
+/// [0, H)) and writes only [b, e), so tiled output can equal untiled output bit for bit. Knows nothing about images.
 ///
 ///   sg::par::parallel_for_tiles(rows, tiles, [&](int t, int begin, int end) {
 ///     kernel(input, output, sg::par::RowRange{begin, end});   // writes rows [begin, end) only
@@ -31,10 +31,6 @@ int tile_count(int rows, int tiles);
 /// tile_count(rows, tiles) contiguous tiles whose sizes differ by at most one (the first
 /// rows % count tiles get the extra row). Tiles are in order and partition [0, rows).
 RowRange tile_rows(int rows, int tiles, int t);
-
-/// [range.begin - halo, range.end + halo) clamped to [0, rows): the rows a tile may read when the
-/// kernel looks `halo` rows above and below. halo < 0 counts as 0.
-RowRange with_halo(RowRange range, int halo, int rows);
 
 /// Body of a tiled loop: (tile index, first row, one past the last row).
 using TileBody = std::function<void(int tile, int begin, int end)>;
