@@ -15,6 +15,7 @@
 #include "outputs.hpp"
 #include "sg/core/error.hpp"
 #include "sg/eval/flow_metrics.hpp"
+#include "sg/io/file_kinds.hpp"
 #include "sg/io/gt_formats.hpp"
 #include "sg/io/stereo_folder.hpp"
 #include "sg/pipeline/dropping_source.hpp"
@@ -55,12 +56,6 @@ struct FlowPair {
   fs::path first, second, gt;
 };
 
-bool is_image(const fs::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".png" || ext == ".ppm" || ext == ".pgm" || ext == ".jpg" || ext == ".bmp";
-}
-
 /// Pairs of one folder: Middlebury (NAME.flo with NAME1.EXT, NAME2.EXT) and FlyingChairs
 /// (ID-gt.flo with ID-img0.EXT, ID-img1.EXT). A .flo without its two images is skipped.
 void find_pairs_in(const fs::path& dir, std::vector<FlowPair>& out) {
@@ -70,7 +65,7 @@ void find_pairs_in(const fs::path& dir, std::vector<FlowPair>& out) {
   std::sort(files.begin(), files.end());
   auto image = [&files](const std::string& stem) -> fs::path {
     for (const auto& f : files)
-      if (f.stem().string() == stem && is_image(f)) return f;
+      if (f.stem().string() == stem && io::is_image_file(f)) return f;
     return {};
   };
   for (const auto& f : files) {

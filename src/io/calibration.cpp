@@ -14,6 +14,7 @@
 #include "gray.hpp"
 #include "sg/core/error.hpp"
 #include "sg/core/yaml_text.hpp"
+#include "sg/io/file_kinds.hpp"
 #include "sg/io/stereo_folder.hpp"
 
 namespace sg::io {
@@ -115,9 +116,7 @@ YAML::Node load_yaml(const fs::path& path);
 
 /// True for a file OpenCV reads as YAML: a .yml or .yaml name, or text starting with "%YAML".
 bool is_yaml_file(const fs::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lower_extension(path);
   if (ext == ".yml" || ext == ".yaml") return true;
   std::string head(5, '\0');
   std::ifstream(path, std::ios::binary).read(head.data(), 5);
@@ -448,7 +447,7 @@ Calibration read_calibration(const fs::path& path, bool kitti_color) {
     throw core::InputError("calibration file not found: " + path.string());
   }
   Calibration out;
-  std::string ext = path.extension().string();
+  const std::string ext = lower_extension(path);
   if (ext == ".txt") {
     out.rectified =
         kitti_color ? read_kitti_calibration(path, 2, 3) : read_kitti_calibration(path, 0, 1);

@@ -11,21 +11,12 @@
 
 #include "gray.hpp"
 #include "sg/core/error.hpp"
+#include "sg/io/file_kinds.hpp"
 #include "sg/io/sources.hpp"
 
 namespace sg::io {
 namespace fs = std::filesystem;
 namespace {
-
-bool is_image(const fs::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  for (const char* e : {".png", ".jpg", ".jpeg", ".bmp", ".pgm", ".ppm", ".tif", ".tiff"}) {
-    if (ext == e) return true;
-  }
-  return false;
-}
 
 /// Seconds since the epoch of "YYYY-MM-DD hh:mm:ss.fffffffff" (KITTI timestamps.txt), split in
 /// whole seconds and a fraction so that nanoseconds survive.
@@ -134,7 +125,7 @@ std::vector<fs::path> list_images(const std::string& folder_or_glob) {
   std::vector<fs::path> files;
   if (fs::is_directory(folder_or_glob, ec)) {
     for (const auto& entry : fs::directory_iterator(folder_or_glob, ec)) {
-      if (entry.is_regular_file(ec) && is_image(entry.path())) files.push_back(entry.path());
+      if (entry.is_regular_file(ec) && is_image_file(entry.path())) files.push_back(entry.path());
     }
     if (files.empty()) throw core::InputError("no images in folder " + folder_or_glob);
   } else if (folder_or_glob.find_first_of("*?[") != std::string::npos) {
@@ -145,7 +136,7 @@ std::vector<fs::path> list_images(const std::string& folder_or_glob) {
       matches.clear();
     }
     for (const auto& m : matches) {
-      if (is_image(m)) files.emplace_back(m);
+      if (is_image_file(m)) files.emplace_back(m);
     }
     if (files.empty()) throw core::InputError("no images match " + folder_or_glob);
   } else {

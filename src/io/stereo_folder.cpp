@@ -14,6 +14,7 @@
 
 #include "sg/core/error.hpp"
 #include "sg/core/yaml_text.hpp"
+#include "sg/io/file_kinds.hpp"
 #include "gray.hpp"
 #include "sg/io/gt_formats.hpp"
 
@@ -37,13 +38,6 @@ std::string one_line(std::string s) {
   return s;
 }
 
-bool is_png(const fs::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".png";
-}
-
 /// Sorted .png files of `dir`; throws when `dir` is not a folder.
 std::vector<fs::path> list_pngs(const fs::path& dir, const fs::path& root, const char* name) {
   std::error_code ec;
@@ -53,7 +47,7 @@ std::vector<fs::path> list_pngs(const fs::path& dir, const fs::path& root, const
   }
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    if (entry.is_regular_file(ec) && is_png(entry.path())) files.push_back(entry.path());
+    if (entry.is_regular_file(ec) && lower_extension(entry.path()) == ".png") files.push_back(entry.path());
   }
   if (ec) throw core::InputError("cannot list folder " + dir.string() + ": " + ec.message());
   std::sort(files.begin(), files.end(),
