@@ -19,7 +19,8 @@ FOLDERS = ["src", "include", "tests", "scripts", "bench", "examples", "python", 
            ".ci"]
 CPP = {".hpp", ".cpp", ".h", ".cc"}
 HASH = {".sh", ".py", ".cmake", ".txt", ".yaml", ".supp", ""}
-PATH = re.compile(r"(?<![\w./-])((?:[\w.-]+/)+[\w.-]+\.(?:hpp|cpp|md|sh|py|yaml|txt|supp|json|cmake))\b")
+PATH = re.compile(r"(?<![\w./-])((?:[\w.-]+/)+[\w.-]+"
+                  r"\.(?:hpp|cpp|md|sh|py|yaml|txt|supp|json|cmake))\b")
 OURS = set(FOLDERS) | {"docs", "sg", "core", "io", "par", "pipeline", "sim", "vision", "eval",
                        "apps"}
 

@@ -3,7 +3,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <cctype>
 #include <charconv>
 #include <cstdio>
 #include <fstream>
@@ -47,7 +46,8 @@ std::vector<fs::path> list_pngs(const fs::path& dir, const fs::path& root, const
   }
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    if (entry.is_regular_file(ec) && lower_extension(entry.path()) == ".png") files.push_back(entry.path());
+    if (entry.is_regular_file(ec) && lower_extension(entry.path()) == ".png")
+      files.push_back(entry.path());
   }
   if (ec) throw core::InputError("cannot list folder " + dir.string() + ": " + ec.message());
   std::sort(files.begin(), files.end(),

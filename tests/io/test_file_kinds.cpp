@@ -14,7 +14,8 @@ TEST(FileKinds, ExtensionsAreReadInAnyCase) {
 }
 
 TEST(FileKinds, StillImagesAreWhatImreadReads) {
-  for (const char* name : {"x.png", "x.JPG", "x.jpeg", "x.bmp", "x.pgm", "x.PPM", "x.tif", "x.TIFF"})
+  for (const char* name :
+       {"x.png", "x.JPG", "x.jpeg", "x.bmp", "x.pgm", "x.PPM", "x.tif", "x.TIFF"})
     EXPECT_TRUE(is_image_file(name)) << name;
   for (const char* name : {"x.flo", "x.pfm", "x.yaml", "x.mp4", "png", "x.png.txt"})
     EXPECT_FALSE(is_image_file(name)) << name;

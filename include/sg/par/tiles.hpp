@@ -2,7 +2,8 @@
 /// Row tiling, the data-parallel skeleton of DESIGN.md section 1 (FastFlow's parallel-for): a task
 /// of H rows is split into T contiguous horizontal tiles computed independently. A tile of rows
 /// [b, e) may read the rows its kernel needs around them (h rows above and below, clamped to
-/// [0, H)) and writes only [b, e), so tiled output can equal untiled output bit for bit. Knows nothing about images.
+/// [0, H)) and writes only [b, e), so tiled output can equal untiled output bit for bit. Knows
+/// nothing about images.
 ///
 ///   sg::par::parallel_for_tiles(rows, tiles, [&](int t, int begin, int end) {
 ///     kernel(input, output, sg::par::RowRange{begin, end});   // writes rows [begin, end) only

@@ -28,7 +28,6 @@ struct RandomSuiteOptions {
 /// Every violation as text ("count=0: must be >= 1"); empty when valid.
 std::vector<std::string> validate(const RandomSuiteOptions& options);
 
-/// One scene's score.
 /// What a scene drew that its description leaves out, for breaking the suite's figures down by
 /// cause (scripts/suite_breakdown.py reads them from the JSON).
 struct RandomSceneTraits {
@@ -43,6 +42,7 @@ struct RandomSceneTraits {
   std::vector<std::string> shapes, paths, textures;
 };
 
+/// One scene's score.
 struct RandomSceneResult {
   std::uint32_t seed = 0;
   std::string description;  ///< sim::random_scenario's

@@ -1,10 +1,10 @@
 #pragma once
 /// The per-pixel labelling of the five detectors the thesis surveys (chapter 3, DESIGN 3.4),
 /// around the kernels of relative_size.hpp, elevation_map.hpp, sceneflow_seg.hpp and longseq.hpp
-/// (motion parallax's is expansion_rate, here). Each writes what the Stereo and Stereo-Flow labellings
-/// write (labelling.hpp, scene_flow.hpp): danger (CV_8U, 0/255) and ttc (CV_32F, s, NaN where
-/// unknown), allocated here, so that the same clean-up, obstacles, tracking and signals follow
-/// (Detector::finish). Pure functions: no threads, no state between frames.
+/// (motion parallax's is expansion_rate, here). Each writes what the Stereo and Stereo-Flow
+/// labellings write (labelling.hpp, scene_flow.hpp): danger (CV_8U, 0/255) and ttc (CV_32F, s,
+/// NaN where unknown), allocated here, so that the same clean-up, obstacles, tracking and signals
+/// follow (Detector::finish). Pure functions: no threads, no state between frames.
 #include <opencv2/core.hpp>
 
 #include "sg/core/camera.hpp"
