@@ -73,7 +73,16 @@ void sample_motion(Draw& d, int platform, double duration_s, Scenario& s,
   double speed = d.in(r.ego_speed_mps[p]);
   if (info.ego_motion == "turning") {
     s.camera_motion.yaw_rate_dps = d.sign() * d.in(r.yaw_rate_dps);
-    speed *= d.in({0.0, 1.0});
+    const double share = d.in({0.0, 1.0});
+    if (platform == kCar) {
+      // No tighter than a car's turning circle, no harder sideways than a driver turns.
+      const double yaw_rps = std::abs(s.camera_motion.yaw_rate_dps) * kDeg;
+      const double lo = yaw_rps * r.car_min_turn_radius_m;
+      const double hi = std::min(speed, r.car_max_lateral_mps2 / yaw_rps);
+      speed = lo + share * (hi - lo);
+    } else {
+      speed *= share;
+    }
     s.ego_follows_heading = true;  // a platform drives where it heads: an arc
   } else if (info.ego_motion == "still") {
     speed = 0.0;

@@ -198,6 +198,30 @@ TEST(RandomScene, NoTwoObstaclesOverlapAtAnyFrame) {
   EXPECT_GT(four, 10);
 }
 
+TEST(RandomScene, ATurningCarDrivesAnArcACarCanDrive) {
+  // Seed 1051 used to turn a car on a 2.4-m radius at 0.9 m/s.
+  const RandomSceneRanges& r = kRandomSceneRanges;
+  int turning_cars = 0;
+  double tightest_m = 1e9, hardest_mps2 = 0.0;
+  for (std::uint32_t seed = 1000; seed < 2000; ++seed) {
+    RandomSceneInfo info;
+    const Scenario s = random_scenario(seed, &info);
+    if (s.platform != "car" || info.ego_motion != "turning") continue;
+    ++turning_cars;
+    const double yaw_rps = std::abs(s.camera_motion.yaw_rate_dps) * kDeg;
+    const double speed = s.ego_velocity_mps[2];
+    tightest_m = std::min(tightest_m, speed / yaw_rps);
+    hardest_mps2 = std::max(hardest_mps2, speed * yaw_rps);
+    EXPECT_LE(speed, r.ego_speed_mps[2].hi) << seed;
+  }
+  EXPECT_GT(turning_cars, 20);
+  EXPECT_GE(tightest_m, r.car_min_turn_radius_m - 1e-9);
+  EXPECT_LE(hardest_mps2, r.car_max_lateral_mps2 + 1e-9);
+  // The bounds are reached, not just respected: the speeds span them.
+  EXPECT_LT(tightest_m, 1.2 * r.car_min_turn_radius_m);
+  EXPECT_GT(hardest_mps2, 0.8 * r.car_max_lateral_mps2);
+}
+
 TEST(RandomScene, CapKeepsTheFieldOfViewAndShortens) {
   Scenario s = random_scenario(7);
   const double fov = std::atan(0.5 * s.camera.width / s.camera.focal_px);

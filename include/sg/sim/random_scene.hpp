@@ -44,6 +44,10 @@ struct RandomSceneRanges {
   std::array<SampleRange, 4> obstacle_speed_mps{{{0.3, 2.0}, {0.3, 2.0}, {1.0, 12.0}, {0.3, 3.0}}};
   /// |yaw rate| of a "turning" ego motion (either sign); it keeps 0..1 of its forward speed.
   SampleRange yaw_rate_dps{5.0, 25.0};
+  /// A turning car drives an arc a car can drive: its share 0..1 spans the speeds from yaw rate
+  /// x car_min_turn_radius_m up to its forward speed or car_max_lateral_mps2 / yaw rate.
+  double car_min_turn_radius_m = 5.0;
+  double car_max_lateral_mps2 = 4.0;
   /// "accelerating": starts at this share of its speed, reaches the speed after the ramp.
   SampleRange start_speed_share{0.0, 0.5};
   SampleRange speed_ramp_s{1.0, 2.5};
