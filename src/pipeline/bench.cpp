@@ -33,7 +33,8 @@ std::vector<core::StereoFrame> render(const sim::Scenario& scenario, int frames)
   for (int i = 0; i < frames; ++i) {
     const int period = 2 * scenario.frames - 2;
     const int k = i % period;
-    core::StereoFrame f = renderer.render(k < scenario.frames ? k : period - k).frame;
+    const int index = k < scenario.frames ? k : period - k;
+    core::StereoFrame f = renderer.render(index, sim::TruthMapSet::kDangerOnly).frame;
     f.index = i;
     f.time_s = i / scenario.camera.fps;
     out.push_back(std::move(f));

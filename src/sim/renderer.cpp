@@ -5,12 +5,13 @@
 #include <limits>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "sg/core/error.hpp"
-#include "texture.hpp"
+#include "sg/sim/texture.hpp"
 
 namespace sg::sim {
 namespace {
@@ -191,21 +192,43 @@ double lit(const Scene& sc, const cv::Vec3d& p) {
   return light;
 }
 
-/// Gray level (before noise and gain) of the surface hit by the ray from o.
-double shade(const Scene& sc, const Hit& hit, const cv::Vec3d& o, const cv::Vec3d& dir) {
-  if (hit.surface == Surface::kSky) return kSkyGray;
+/// What the gray level of a hit needs besides its texture's noise: light (base + kContrast
+/// pattern_from_noise(kind, u, v, seed, footprint, noise)), or the sky's gray.
+struct SurfacePoint {
+  bool sky = true;
+  int kind = 0;  // TextureKind as an index
+  std::uint32_t seed = 0;
+  double u = 0.0, v = 0.0;  // texture coordinates, m
+  double footprint = 0.0;   // the pixel's footprint in texture units
+  double base = 0.0;        // albedo (times the face's shade on a box)
+  double light = 1.0;       // share of the light reaching the point (lit)
+};
+
+/// The surface point hit by the ray from o, with what shading it needs, into s (written in place:
+/// a returned copy of the struct costs a store-forwarding stall per pixel).
+void surface_point(const Scene& sc, const Hit& hit, const cv::Vec3d& o, const cv::Vec3d& dir,
+                   SurfacePoint& s) {
+  s.sky = hit.surface == Surface::kSky;
+  if (s.sky) return;
   const cv::Vec3d p = o + dir * hit.depth;
-  const double light = sc.casters.empty() ? 1.0 : lit(sc, p);
+  s.light = sc.casters.empty() ? 1.0 : lit(sc, p);
   if (hit.surface == Surface::kGround) {
-    const double fp = footprint(sc, 1, hit.depth, dir, 0, 2, 1.0, kGroundStretchZ);
-    return light * (sc.ground_albedo + kContrast * pattern_value(sc.ground_texture, p[0],
-                                                                 p[2] / kGroundStretchZ,
-                                                                 sc.ground_seed, fp));
+    s.footprint = footprint(sc, 1, hit.depth, dir, 0, 2, 1.0, kGroundStretchZ);
+    s.kind = sc.ground_texture;
+    s.seed = sc.ground_seed;
+    s.u = p[0];
+    s.v = p[2] / kGroundStretchZ;
+    s.base = sc.ground_albedo;
+    return;
   }
   if (hit.surface == Surface::kWall) {
-    const double fp = footprint(sc, 2, hit.depth, dir, 0, 1, 1.0, 1.0);
-    return light * (sc.wall_albedo +
-                    kContrast * pattern_value(sc.wall_texture, p[0], p[1], sc.wall_seed, fp));
+    s.footprint = footprint(sc, 2, hit.depth, dir, 0, 1, 1.0, 1.0);
+    s.kind = sc.wall_texture;
+    s.seed = sc.wall_seed;
+    s.u = p[0];
+    s.v = p[1];
+    s.base = sc.wall_albedo;
+    return;
   }
   const BoxNow& b = sc.boxes[static_cast<std::size_t>(hit.box)];
   const cv::Vec3d local = p - b.centre;
@@ -214,11 +237,19 @@ double shade(const Scene& sc, const Hit& hit, const cv::Vec3d& o, const cv::Vec3
   static constexpr int kV[3] = {1, 2, 1};
   static constexpr double kFaceShade[3] = {0.8, 1.15, 1.0};
   const int u = kU[hit.axis], v = kV[hit.axis];
-  const double fp = footprint(sc, hit.axis, hit.depth, dir, u, v, 1.0, 1.0);
-  const auto face = static_cast<std::uint32_t>(hit.axis * 2 + hit.side);
-  return light * (b.albedo * kFaceShade[hit.axis] +
-                   kContrast * pattern_value(b.texture, local[u], local[v],
-                                             hash_combine(b.seed, face), fp));
+  s.footprint = footprint(sc, hit.axis, hit.depth, dir, u, v, 1.0, 1.0);
+  s.kind = b.texture;
+  s.seed = hash_combine(b.seed, static_cast<std::uint32_t>(hit.axis * 2 + hit.side));
+  s.u = local[u];
+  s.v = local[v];
+  s.base = b.albedo * kFaceShade[hit.axis];
+}
+
+/// Gray level (before noise and gain) of a surface point whose texture noise is `noise`.
+double shade_point(const SurfacePoint& s, double noise) {
+  if (s.sky) return kSkyGray;
+  return s.light *
+         (s.base + kContrast * pattern_from_noise(s.kind, s.u, s.v, s.seed, s.footprint, noise));
 }
 
 /// Identity of the surface a ray hit (sky, ground, wall, or one face of one box): where it
@@ -242,11 +273,48 @@ struct RowTargets {
   cv::Mat* code = nullptr;   // CV_32S
 };
 
+/// Surface points shaded together: the gray level (before noise and gain) of each, shade_point
+/// with the textures of all at once (texture_values, equal to texture_value bit for bit).
+struct ShadingBatch {
+  std::vector<SurfacePoint> points;
+  std::vector<double> shades;  // shade_all's output, one per point
+
+  /// shades[i] = shade_point(points[i], texture_value of it) for every point.
+  void shade_all() {
+    const std::size_t m = points.size();
+    u_.resize(m);
+    v_.resize(m);
+    footprint_.resize(m);
+    seed_.resize(m);
+    noise_.resize(m);
+    shades.resize(m);
+    int n = 0;
+    for (const SurfacePoint& s : points) {
+      if (s.sky) continue;
+      u_[n] = s.u;
+      v_[n] = s.v;
+      footprint_[n] = s.footprint;
+      seed_[n] = s.seed;
+      ++n;
+    }
+    texture_values(u_.data(), v_.data(), seed_.data(), footprint_.data(), n, noise_.data());
+    int k = 0;
+    for (std::size_t i = 0; i < m; ++i)
+      shades[i] = shade_point(points[i], points[i].sky ? 0.0 : noise_[k++]);
+  }
+
+ private:
+  std::vector<double> u_, v_, footprint_, noise_;
+  std::vector<std::uint32_t> seed_;
+};
+
 /// Renders rows [rows.start, rows.end) of the camera at `eye` with one ray through each pixel's
 /// centre; for the gray image only its shade and surface (integrate_rows finishes it). Each pixel
 /// depends only on its own ray, so any split into row ranges gives the same images.
 void render_rows(const Scene& sc, const cv::Vec3d& eye, const cv::Vec3d& eye_prev,
                  const RowTargets& out, cv::Range rows, int width) {
+  ShadingBatch shading;
+  shading.points.resize(out.shade ? static_cast<std::size_t>(width) : 0);
   for (int y = rows.start; y < rows.end; ++y) {
     const double dy = (y - sc.cy) / sc.f;
     auto* shade_row = out.shade ? out.shade->ptr<float>(y) : nullptr;
@@ -259,7 +327,7 @@ void render_rows(const Scene& sc, const cv::Vec3d& eye, const cv::Vec3d& eye_pre
       const cv::Vec3d dir = sc.rot * cv::Vec3d(dx, dy, 1.0);
       const Hit hit = cast(sc, eye, dir);
       if (shade_row) {
-        shade_row[x] = static_cast<float>(shade(sc, hit, eye, dir));
+        surface_point(sc, hit, eye, dir, shading.points[static_cast<std::size_t>(x)]);
         code_row[x] = surface_code(hit);
       }
       const bool is_box = hit.surface == Surface::kBox;
@@ -291,6 +359,11 @@ void render_rows(const Scene& sc, const cv::Vec3d& eye, const cv::Vec3d& eye_pre
         flow[x] = q;
       }
     }
+    if (shade_row) {
+      shading.shade_all();
+      for (int x = 0; x < width; ++x)
+        shade_row[x] = static_cast<float>(shading.shades[static_cast<std::size_t>(x)]);
+    }
   }
 }
 
@@ -302,6 +375,8 @@ void integrate_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out
                     cv::Range rows) {
   const cv::Mat& code = *out.code;
   const int n = out.edge_samples, w = code.cols, h = code.rows;
+  ShadingBatch samples;      // the rays of the row's edge pixels, n^2 each, in pixel order
+  std::vector<char> edge(static_cast<std::size_t>(w));
   for (int y = rows.start; y < rows.end; ++y) {
     const auto* c = code.ptr<std::int32_t>(y);
     const auto* above = y > 0 ? code.ptr<std::int32_t>(y - 1) : c;
@@ -309,20 +384,27 @@ void integrate_rows(const Scene& sc, const cv::Vec3d& eye, const RowTargets& out
     const auto* shade_row = out.shade->ptr<float>(y);
     const auto* noise = out.noise ? out.noise->ptr<float>(y) : nullptr;
     auto* gray = out.gray->ptr<std::uint8_t>(y);
+    samples.points.clear();
+    for (int x = 0; x < w; ++x) {
+      edge[x] = n > 1 && ((x > 0 && c[x - 1] != c[x]) || (x + 1 < w && c[x + 1] != c[x]) ||
+                          above[x] != c[x] || below[x] != c[x]);
+      if (!edge[x]) continue;
+      for (int j = 0; j < n; ++j) {
+        const double dy = (y - 0.5 + (j + 0.5) / n - sc.cy) / sc.f;
+        for (int i = 0; i < n; ++i) {
+          const double dx = (x - 0.5 + (i + 0.5) / n - sc.cx) / sc.f;
+          const cv::Vec3d dir = sc.rot * cv::Vec3d(dx, dy, 1.0);
+          surface_point(sc, cast(sc, eye, dir), eye, dir, samples.points.emplace_back());
+        }
+      }
+    }
+    samples.shade_all();
+    const double* sample = samples.shades.data();
     for (int x = 0; x < w; ++x) {
       double value = shade_row[x];
-      const bool edge = n > 1 && ((x > 0 && c[x - 1] != c[x]) || (x + 1 < w && c[x + 1] != c[x]) ||
-                                  above[x] != c[x] || below[x] != c[x]);
-      if (edge) {
+      if (edge[x]) {
         double sum = 0.0;
-        for (int j = 0; j < n; ++j) {
-          const double dy = (y - 0.5 + (j + 0.5) / n - sc.cy) / sc.f;
-          for (int i = 0; i < n; ++i) {
-            const double dx = (x - 0.5 + (i + 0.5) / n - sc.cx) / sc.f;
-            const cv::Vec3d dir = sc.rot * cv::Vec3d(dx, dy, 1.0);
-            sum += shade(sc, cast(sc, eye, dir), eye, dir);
-          }
-        }
+        for (int k = 0; k < n * n; ++k) sum += *sample++;
         value = sum / (n * n);
       }
       value *= out.gain;
@@ -566,23 +648,24 @@ Renderer::Renderer(Scenario scenario) : scenario_(std::move(scenario)) {
   core::throw_if_invalid(validate(scenario_), "invalid scenario '" + scenario_.name + "'");
 }
 
-RenderedFrame Renderer::render(int index) const {
+RenderedFrame Renderer::render(int index, TruthMapSet maps) const {
   check_index(scenario_, index);
   const Scenario& s = scenario_;
   const int w = s.camera.width, h = s.camera.height;
   const Scene sc = make_scene(s, index);
+  const bool all_maps = maps == TruthMapSet::kAll;
 
   RenderedFrame r;
   r.frame.index = index;
   r.frame.time_s = index / s.camera.fps;
   r.frame.left.create(h, w, CV_8UC1);
   r.frame.right.create(h, w, CV_8UC1);
-  r.maps.disparity.create(h, w, CV_32FC1);
+  if (all_maps) r.maps.disparity.create(h, w, CV_32FC1);
   r.maps.ids.create(h, w, CV_16UC1);
-  if (index > 0) r.maps.flow.create(h, w, CV_32FC2);
+  if (index > 0 && all_maps) r.maps.flow.create(h, w, CV_32FC2);
   // Motion blur needs each camera's own image motion, frame 0's too.
   const bool blur = s.effects.exposure_time_s > 0.0;
-  cv::Mat left_flow = index > 0 ? r.maps.flow : cv::Mat(), right_flow;
+  cv::Mat left_flow = r.maps.flow, right_flow;
   if (blur) {
     if (left_flow.empty()) left_flow.create(h, w, CV_32FC2);
     right_flow.create(h, w, CV_32FC2);
@@ -604,7 +687,7 @@ RenderedFrame Renderer::render(int index) const {
   left.gray = &r.frame.left;
   left.noise = noise[0].empty() || blur ? nullptr : &noise[0];
   left.edge_samples = s.edge_samples;
-  left.disparity = &r.maps.disparity;
+  left.disparity = all_maps ? &r.maps.disparity : nullptr;
   left.flow = left_flow.empty() ? nullptr : &left_flow;
   left.ids = &r.maps.ids;
   render_parallel(sc, sc.eye, sc.eye_prev, left, w, h);
@@ -643,7 +726,7 @@ ScenarioSource::ScenarioSource(Scenario scenario) : renderer_(std::move(scenario
 
 std::optional<core::StereoFrame> ScenarioSource::next() {
   if (next_index_ >= renderer_.scenario().frames) return std::nullopt;
-  last_ = renderer_.render(next_index_++);
+  last_ = renderer_.render(next_index_++, TruthMapSet::kDangerOnly);
   return last_.frame;
 }
 
@@ -654,7 +737,9 @@ std::optional<core::PendingFrame> ScenarioSource::next_pending() {
   pending.index = index;
   pending.time_s = index / renderer_.scenario().camera.fps;  // as render() stamps it
   const Renderer* renderer = &renderer_;
-  pending.load = [renderer, index] { return renderer->render(index).frame; };
+  pending.load = [renderer, index] {
+    return renderer->render(index, TruthMapSet::kDangerOnly).frame;
+  };
   pending.load_where_read = true;
   return pending;
 }

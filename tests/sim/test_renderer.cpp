@@ -85,6 +85,31 @@ TEST(Renderer, OutputsHaveTheDeclaredTypes) {
   EXPECT_THROW(r.render(r.scenario().frames), std::out_of_range);
 }
 
+TEST(Renderer, DangerOnlyRendersTheSameImagesAndTruthWithoutDisparityAndFlow) {
+  // With and without motion blur (which needs each camera's flow inside the renderer).
+  for (double exposure_s : {0.0, 0.02}) {
+    Scenario s = small("head-on");
+    s.effects.exposure_time_s = exposure_s;
+    const Renderer r(s);
+    // Frame 0, and the last, where the box is inside the horizon.
+    for (int i : {0, s.frames - 1}) {
+      const RenderedFrame all = r.render(i), lean = r.render(i, TruthMapSet::kDangerOnly);
+      EXPECT_EQ(cv::norm(all.frame.left, lean.frame.left, cv::NORM_INF), 0.0) << i;
+      EXPECT_EQ(cv::norm(all.frame.right, lean.frame.right, cv::NORM_INF), 0.0) << i;
+      EXPECT_EQ(cv::norm(all.maps.danger, lean.maps.danger, cv::NORM_INF), 0.0) << i;
+      EXPECT_EQ(cv::norm(all.maps.ids, lean.maps.ids, cv::NORM_INF), 0.0) << i;
+      EXPECT_GT(cv::countNonZero(lean.maps.ids), 0) << i;
+      if (i > 0) {
+        EXPECT_GT(cv::countNonZero(lean.maps.danger), 0);
+      }
+      EXPECT_EQ(all.truth.alarm, lean.truth.alarm) << i;
+      EXPECT_TRUE(lean.maps.disparity.empty());
+      EXPECT_TRUE(lean.maps.flow.empty());
+      EXPECT_FALSE(all.maps.disparity.empty());
+    }
+  }
+}
+
 TEST(Renderer, GroundDisparityMatchesThePlane) {
   Scenario s = small("static");
   s.obstacles.clear();
@@ -329,7 +354,11 @@ TEST(ScenarioSource, StreamsEveryFrameWithItsTruth) {
     EXPECT_EQ(frame->index, i);
     EXPECT_DOUBLE_EQ(frame->time_s, i / 30.0);
     EXPECT_EQ(source.last_truth().frame, i);
-    EXPECT_EQ(source.last_maps().flow.empty(), i == 0);
+    // What scoring needs (TruthMapSet::kDangerOnly), not the disparity and flow.
+    EXPECT_EQ(source.last_maps().danger.size(), cv::Size(161, 121));
+    EXPECT_EQ(source.last_maps().ids.size(), cv::Size(161, 121));
+    EXPECT_TRUE(source.last_maps().flow.empty());
+    EXPECT_TRUE(source.last_maps().disparity.empty());
   }
   EXPECT_FALSE(source.next().has_value());
 }

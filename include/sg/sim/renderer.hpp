@@ -9,9 +9,15 @@ namespace sg::sim {
 
 struct RenderedFrame {
   core::StereoFrame frame;  ///< left/right CV_8UC1, time_s = index / fps
-  core::TruthMaps maps;     ///< disparity, backward flow (empty for frame 0), danger, ids
+  /// disparity, backward flow (empty for frame 0), danger, ids; with TruthMapSet::kDangerOnly
+  /// danger and ids only
+  core::TruthMaps maps;
   core::FrameTruth truth;
 };
+
+/// The truth maps Renderer::render produces: all of them, or only what a detection's scoring
+/// needs (danger and ids; disparity and flow are left empty, which saves their per-pixel work).
+enum class TruthMapSet { kAll, kDangerOnly };
 
 /// Ground-truth collision test of one box at time t_s (DESIGN 4), relative to the moving camera
 /// with constant relative velocity V = box_velocity(t_s) - ego_velocity (a box that accelerates
@@ -45,8 +51,9 @@ class Renderer {
  public:
   /// Throws core::InputError when validate(scenario) finds problems.
   explicit Renderer(Scenario scenario);
-  /// Images and ground truth of frame `index` (0 <= index < frames), t = index / fps.
-  RenderedFrame render(int index) const;
+  /// Images and ground truth of frame `index` (0 <= index < frames), t = index / fps. The
+  /// images do not depend on `maps`.
+  RenderedFrame render(int index, TruthMapSet maps = TruthMapSet::kAll) const;
   /// Only the FrameTruth of frame `index` (ray casting without shading; several times faster).
   core::FrameTruth truth(int index) const;
   const Scenario& scenario() const { return scenario_; }
@@ -70,6 +77,7 @@ class ScenarioSource : public core::FrameSource {
   const core::FrameTruth& last_truth() const { return last_.truth; }
   /// The scenario rendered.
   const Scenario& scenario() const { return renderer_.scenario(); }
+  /// Truth maps of the frame last returned by next(): danger and ids only (TruthMapSet).
   const core::TruthMaps& last_maps() const { return last_.maps; }
 
  private:

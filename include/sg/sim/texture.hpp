@@ -1,8 +1,11 @@
 #pragma once
 /// Procedural surface texture of the simulator: band-limited multi-octave value noise, a pure
 /// function of surface coordinates in metres, so textures stay fixed to the objects.
+/// texture_value is the reference; texture_values evaluates many points at once with SIMD and
+/// equals it bit for bit.
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace sg::sim {
@@ -105,11 +108,20 @@ inline double soft_square(double a, double period, double footprint_m) {
   return v * (1.0 - smoothstep01((footprint_m / period - 0.2) / 0.3));
 }
 
-/// Surface value in about [-1, 1] of a TextureKind (sg/sim/scenario.hpp; passed as its index so
-/// that this header stays free of the scenario): 0 noise, 1 low, 2 tiles, 3 stripes, 4 clutter.
-/// Sizes (tile side, stripe period and angle, glyph height) follow from the seed.
-inline double pattern_value(int kind, double u, double v, std::uint32_t seed, double footprint_m) {
-  const double noise = texture_value(u, v, seed, footprint_m);
+/// texture_value(u[i], v[i], seed[i], footprint_m[i]) with the default TextureParams into out[i]
+/// for i in [0, n), bit for bit: a SIMD kernel (Google Highway, dispatched at run time) doing the
+/// reference's operations lane by lane in the same order, its file compiled without fused
+/// multiply-adds. Octaves a lane leaves out leave its sum untouched, as the reference's loop does.
+void texture_values(const double* u, const double* v, const std::uint32_t* seed,
+                    const double* footprint_m, int n, double* out);
+
+/// The SIMD target texture_values runs on this machine (e.g. "AVX3").
+std::string texture_target();
+
+/// pattern_value given noise = texture_value(u, v, seed, footprint_m), so that the noise of many
+/// points can be computed at once (texture_values).
+inline double pattern_from_noise(int kind, double u, double v, std::uint32_t seed,
+                                 double footprint_m, double noise) {
   if (kind == 0) return noise;
   if (kind == 1) return 0.125 * noise;
   const std::uint32_t h = hash_u32(seed ^ 0x51ed270bU);
@@ -142,6 +154,14 @@ inline double pattern_value(int kind, double u, double v, std::uint32_t seed, do
     if (col < 3 && g % 6U != 0U && ((g >> (1 + row * 3 + col)) & 1U)) value = -0.6;  // ink
   }
   return kMean + weight * (value - kMean) + 0.15 * noise;
+}
+
+/// Surface value in about [-1, 1] of a TextureKind (sg/sim/scenario.hpp; passed as its index so
+/// that this header stays free of the scenario): 0 noise, 1 low, 2 tiles, 3 stripes, 4 clutter.
+/// Sizes (tile side, stripe period and angle, glyph height) follow from the seed.
+inline double pattern_value(int kind, double u, double v, std::uint32_t seed, double footprint_m) {
+  return pattern_from_noise(kind, u, v, seed, footprint_m,
+                            texture_value(u, v, seed, footprint_m));
 }
 
 }  // namespace sg::sim
