@@ -1,10 +1,8 @@
 // `stereoguard eval`: detection accuracy against ground truth, or optical-flow accuracy (--flow).
-#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <map>
-#include <opencv2/imgcodecs.hpp>
 #include <vector>
 
 #include "commands.hpp"
@@ -15,12 +13,11 @@
 #include "outputs.hpp"
 #include "sg/core/error.hpp"
 #include "sg/eval/flow_metrics.hpp"
-#include "sg/io/file_kinds.hpp"
 #include "sg/io/gt_formats.hpp"
 #include "sg/io/stereo_folder.hpp"
 #include "sg/pipeline/dropping_source.hpp"
 #include "sg/pipeline/evaluation.hpp"
-#include "sg/vision/flow.hpp"
+#include "sg/pipeline/flow_evaluation.hpp"
 
 namespace sg::apps {
 namespace {
@@ -50,66 +47,6 @@ struct EvalArgs {
   SuiteEvalArgs suite;
 };
 
-/// Two images and the forward GT flow from the first to the second.
-struct FlowPair {
-  std::string name;
-  fs::path first, second, gt;
-};
-
-/// Pairs of one folder: Middlebury (NAME.flo with NAME1.EXT, NAME2.EXT) and FlyingChairs
-/// (ID-gt.flo with ID-img0.EXT, ID-img1.EXT). A .flo without its two images is skipped.
-void find_pairs_in(const fs::path& dir, std::vector<FlowPair>& out) {
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_regular_file()) files.push_back(e.path());
-  std::sort(files.begin(), files.end());
-  auto image = [&files](const std::string& stem) -> fs::path {
-    for (const auto& f : files)
-      if (f.stem().string() == stem && io::is_image_file(f)) return f;
-    return {};
-  };
-  for (const auto& f : files) {
-    if (f.extension() != ".flo") continue;
-    const std::string stem = f.stem().string();
-    const std::string suffix = "-gt";
-    fs::path a, b;
-    std::string name = stem;
-    if (stem.size() > suffix.size() && stem.compare(stem.size() - 3, 3, suffix) == 0) {
-      name = stem.substr(0, stem.size() - 3);
-      a = image(name + "-img0");
-      b = image(name + "-img1");
-    } else {
-      a = image(stem + "1");
-      b = image(stem + "2");
-    }
-    if (!a.empty() && !b.empty()) out.push_back({name, a, b, f});
-  }
-}
-
-/// The folder's pairs and those of its direct subfolders, in name order.
-std::vector<FlowPair> find_pairs(const fs::path& dir) {
-  if (!fs::is_directory(dir)) throw core::InputError("flow folder " + dir.string() + " does not exist");
-  std::vector<FlowPair> out;
-  find_pairs_in(dir, out);
-  std::vector<fs::path> subdirs;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_directory()) subdirs.push_back(e.path());
-  std::sort(subdirs.begin(), subdirs.end());
-  for (const auto& d : subdirs) find_pairs_in(d, out);
-  if (out.empty())
-    throw core::InputError("flow folder " + dir.string() +
-                           ": no pair found (NAME1/NAME2 + NAME.flo, or ID-img0/ID-img1 + "
-                           "ID-gt.flo)");
-  return out;
-}
-
-cv::Mat read_gray(const fs::path& path) {
-  if (!fs::is_regular_file(path)) throw core::InputError("image " + path.string() + " does not exist");
-  cv::Mat img = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
-  if (img.empty()) throw core::InputError("image " + path.string() + " cannot be decoded");
-  return img;
-}
-
 std::vector<core::FlowMethod> flow_methods(const std::string& text) {
   if (text == "all")
     return {core::FlowMethod::kDisUltrafast, core::FlowMethod::kDisFast,
@@ -118,48 +55,34 @@ std::vector<core::FlowMethod> flow_methods(const std::string& text) {
 }
 
 void eval_flow_main(const EvalArgs& args) {
-  std::vector<FlowPair> pairs;
+  std::vector<io::FlowGtPair> pairs;
   if (!args.dir.empty()) {
     if (!args.left.empty() || !args.right.empty() || !args.gt.empty())
       throw core::InputError("eval --flow: give either --dir or --left/--right/--gt");
-    pairs = find_pairs(args.dir);
+    pairs = io::find_flow_gt_pairs(args.dir);
   } else {
     if (args.left.empty() || args.right.empty() || args.gt.empty())
       throw core::InputError("eval --flow: give --left A --right B --gt FILE.flo, or --dir D");
     pairs.push_back({fs::path(args.left).stem().string(), args.left, args.right, args.gt});
   }
   const std::vector<core::FlowMethod> methods = flow_methods(args.flow_methods);
-  for (const FlowPair& pair : pairs)
-    for (const fs::path& f : {pair.first, pair.second, pair.gt})
-      if (!fs::is_regular_file(f)) throw core::InputError("file " + f.string() + " does not exist");
   nlohmann::json rows = nlohmann::json::array();
   std::map<std::string, std::pair<double, double>> sums;
-  std::printf("%-16s %-14s %9s %8s\n", "pair", "method", "EPE px", "bad3 %");
-  for (const FlowPair& pair : pairs) {
-    const cv::Mat first = read_gray(pair.first), second = read_gray(pair.second);
-    const cv::Mat gt = io::read_flo(pair.gt);
-    if (first.size() != second.size() || first.size() != gt.size())
-      throw core::InputError("pair " + pair.name + ": sizes differ (" + pair.first.string() + ", " +
-                             pair.second.string() + ", " + pair.gt.string() + ")");
-    for (core::FlowMethod m : methods) {
-      core::FlowParams params;
-      params.method = m;
-      cv::Mat flow;
-      // The GT is forward (first -> second); our flow is backward (current -> previous), so the
-      // first image plays "current" and the second "previous".
-      vision::compute_flow(first, second, params, flow);
-      const eval::FlowAccuracy a = eval::flow_accuracy(flow, gt);
-      std::printf("%-16s %-14s %9.3f %8.2f\n", pair.name.c_str(), core::to_string(m), a.epe,
-                  a.bad3_percent);
-      sums[core::to_string(m)].first += a.epe;
-      sums[core::to_string(m)].second += a.bad3_percent;
-      rows.push_back({{"pair", pair.name},
-                      {"method", core::to_string(m)},
-                      {"epe_px", a.epe},
-                      {"bad3_percent", a.bad3_percent},
-                      {"valid_pixels", a.valid_pixels}});
-    }
-  }
+  bool header = false;
+  pipeline::evaluate_flow(pairs, methods, [&](const pipeline::FlowEvalRow& row) {
+    if (!header) std::printf("%-16s %-14s %9s %8s\n", "pair", "method", "EPE px", "bad3 %");
+    header = true;
+    const eval::FlowAccuracy& a = row.accuracy;
+    const char* method = core::to_string(row.method);
+    std::printf("%-16s %-14s %9.3f %8.2f\n", row.pair.c_str(), method, a.epe, a.bad3_percent);
+    sums[method].first += a.epe;
+    sums[method].second += a.bad3_percent;
+    rows.push_back({{"pair", row.pair},
+                    {"method", method},
+                    {"epe_px", a.epe},
+                    {"bad3_percent", a.bad3_percent},
+                    {"valid_pixels", a.valid_pixels}});
+  });
   if (pairs.size() > 1)
     for (core::FlowMethod m : methods) {
       const auto& s = sums[core::to_string(m)];

@@ -10,9 +10,41 @@
 #include <vector>
 
 #include "sg/core/error.hpp"
+#include "sg/io/file_kinds.hpp"
 
 namespace sg::io {
 namespace {
+
+namespace fs = std::filesystem;
+
+/// The pairs of one folder (find_flow_gt_pairs), appended to `out` in name order.
+void find_flow_pairs_in(const fs::path& dir, std::vector<FlowGtPair>& out) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_regular_file()) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  auto image = [&files](const std::string& stem) -> fs::path {
+    for (const auto& f : files)
+      if (f.stem().string() == stem && is_image_file(f)) return f;
+    return {};
+  };
+  for (const auto& f : files) {
+    if (f.extension() != ".flo") continue;
+    const std::string stem = f.stem().string();
+    const std::string suffix = "-gt";
+    fs::path a, b;
+    std::string name = stem;
+    if (stem.size() > suffix.size() && stem.compare(stem.size() - 3, 3, suffix) == 0) {
+      name = stem.substr(0, stem.size() - 3);
+      a = image(name + "-img0");
+      b = image(name + "-img1");
+    } else {
+      a = image(stem + "1");
+      b = image(stem + "2");
+    }
+    if (!a.empty() && !b.empty()) out.push_back({name, a, b, f});
+  }
+}
 
 constexpr float kFloTag = 202021.25f;
 // Larger than any real image; rejects garbage headers before allocating.
@@ -176,6 +208,23 @@ void write_disparity_png(const std::filesystem::path& path, const cv::Mat& dispa
     ok = false;
   }
   if (!ok) throw core::InputError("cannot write disparity PNG: " + path.string());
+}
+
+std::vector<FlowGtPair> find_flow_gt_pairs(const std::filesystem::path& dir) {
+  if (!fs::is_directory(dir))
+    throw core::InputError("flow folder " + dir.string() + " does not exist");
+  std::vector<FlowGtPair> out;
+  find_flow_pairs_in(dir, out);
+  std::vector<fs::path> subdirs;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_directory()) subdirs.push_back(e.path());
+  std::sort(subdirs.begin(), subdirs.end());
+  for (const auto& d : subdirs) find_flow_pairs_in(d, out);
+  if (out.empty())
+    throw core::InputError("flow folder " + dir.string() +
+                           ": no pair found (NAME1/NAME2 + NAME.flo, or ID-img0/ID-img1 + "
+                           "ID-gt.flo)");
+  return out;
 }
 
 }  // namespace sg::io

@@ -179,5 +179,37 @@ TEST(DisparityPng, MissingFile) {
   EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
 }
 
+TEST(FlowGtPairs, FindsMiddleburyAndFlyingChairsNamesInTheFolderAndItsSubfolders) {
+  ScratchDir tmp;
+  const auto touch = [](const fs::path& p) { std::ofstream(p) << "x"; };
+  fs::create_directories(tmp.path() / "RubberWhale");
+  for (const char* f : {"RubberWhale1.png", "RubberWhale2.png", "RubberWhale.flo"})
+    touch(tmp.path() / "RubberWhale" / f);
+  for (const char* f : {"0000002-img0.ppm", "0000002-img1.ppm", "0000002-gt.flo",
+                        "0000001-img0.ppm", "0000001-img1.ppm", "0000001-gt.flo",
+                        "lonely.flo", "0000003-img0.ppm", "0000003-gt.flo", "notes.txt"})
+    touch(tmp.path() / f);
+  const std::vector<FlowGtPair> pairs = find_flow_gt_pairs(tmp.path());
+  // The folder's own pairs in name order, then the subfolder's; .flo files without both images
+  // (lonely, 0000003) are left out.
+  ASSERT_EQ(pairs.size(), 3u);
+  EXPECT_EQ(pairs[0].name, "0000001");
+  EXPECT_EQ(pairs[0].first.filename(), "0000001-img0.ppm");
+  EXPECT_EQ(pairs[0].second.filename(), "0000001-img1.ppm");
+  EXPECT_EQ(pairs[0].gt.filename(), "0000001-gt.flo");
+  EXPECT_EQ(pairs[1].name, "0000002");
+  EXPECT_EQ(pairs[2].name, "RubberWhale");
+  EXPECT_EQ(pairs[2].first.filename(), "RubberWhale1.png");
+  EXPECT_EQ(pairs[2].second.filename(), "RubberWhale2.png");
+}
+
+TEST(FlowGtPairs, AMissingOrEmptyFolderIsAnInputError) {
+  ScratchDir tmp;
+  EXPECT_NE(input_error_of([&] { find_flow_gt_pairs(tmp.path() / "nowhere"); }).find("nowhere"),
+            std::string::npos);
+  EXPECT_NE(input_error_of([&] { find_flow_gt_pairs(tmp.path()); }).find("no pair found"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace sg::io
