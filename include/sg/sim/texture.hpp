@@ -118,8 +118,11 @@ void texture_values(const double* u, const double* v, const std::uint32_t* seed,
 /// The SIMD target texture_values runs on this machine (e.g. "AVX3").
 std::string texture_target();
 
-/// pattern_value given noise = texture_value(u, v, seed, footprint_m), so that the noise of many
-/// points can be computed at once (texture_values).
+/// Surface value in about [-1, 1] of a TextureKind (sg/sim/scenario.hpp; passed as its index so
+/// that this header stays free of the scenario): 0 noise, 1 low, 2 tiles, 3 stripes, 4 clutter.
+/// Sizes (tile side, stripe period and angle, glyph height) follow from the seed. `noise` is
+/// texture_value(u, v, seed, footprint_m), taken as an argument so that the noise of many points
+/// can be computed at once (texture_values).
 inline double pattern_from_noise(int kind, double u, double v, std::uint32_t seed,
                                  double footprint_m, double noise) {
   if (kind == 0) return noise;
@@ -154,14 +157,6 @@ inline double pattern_from_noise(int kind, double u, double v, std::uint32_t see
     if (col < 3 && g % 6U != 0U && ((g >> (1 + row * 3 + col)) & 1U)) value = -0.6;  // ink
   }
   return kMean + weight * (value - kMean) + 0.15 * noise;
-}
-
-/// Surface value in about [-1, 1] of a TextureKind (sg/sim/scenario.hpp; passed as its index so
-/// that this header stays free of the scenario): 0 noise, 1 low, 2 tiles, 3 stripes, 4 clutter.
-/// Sizes (tile side, stripe period and angle, glyph height) follow from the seed.
-inline double pattern_value(int kind, double u, double v, std::uint32_t seed, double footprint_m) {
-  return pattern_from_noise(kind, u, v, seed, footprint_m,
-                            texture_value(u, v, seed, footprint_m));
 }
 
 }  // namespace sg::sim
