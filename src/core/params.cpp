@@ -223,6 +223,8 @@ std::vector<std::string> validate(const GroundParams& p) {
   c.require(p.sample_step_px >= 1, "sample_step_px", p.sample_step_px, "must be >= 1");
   c.require(p.iterations >= 1, "iterations", p.iterations, "must be >= 1");
   c.require(finite_positive(p.tolerance_m), "tolerance_m", p.tolerance_m, "must be > 0");
+  c.require(std::isfinite(p.side_margin_px) && p.side_margin_px >= 0, "side_margin_px",
+            p.side_margin_px, "must be >= 0");
   c.require(finite_positive(p.z_max_m), "z_max_m", p.z_max_m, "must be > 0");
   c.require(p.min_inliers >= 3, "min_inliers", p.min_inliers, "must be >= 3");
   return out;

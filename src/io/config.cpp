@@ -228,6 +228,8 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
           .field("tolerance_m", p.scene_flow.ground.tolerance_m)
           .field("z_max_m", p.scene_flow.ground.z_max_m)
           .field("min_inliers", p.scene_flow.ground.min_inliers)
+          .field("split_surfaces", p.scene_flow.ground.split_surfaces)
+          .field("side_margin_px", p.scene_flow.ground.side_margin_px)
           .done();
     }
     Section(root["motion_parallax"], "motion_parallax")

@@ -240,23 +240,35 @@ void LabelJob::conclude() {
   if (concluded_) return;
   const core::DetectorParams& p = *params_;
   const core::SceneFlowParams& sf = p.scene_flow;
-  if (flow_mode_ && sf.pool_surface_motion) {
+  // The ground plane's pixels are never dangerous. With pooling, no surface joins the ground's
+  // side with what stands on it. Without pooling only dangerous pixels are tested, so a frame
+  // without any needs no plane (the same masks as testing every pixel).
+  const bool pool = flow_mode_ && sf.pool_surface_motion;
+  GroundPlane plane;
+  bool fitted = false;
+  auto ground_plane = [&]() -> const GroundPlane& {
+    if (!fitted) plane = fit_ground_plane(disparity_, *camera_, sf.ground);
+    fitted = true;
+    return plane;
+  };
+  if (pool) {
+    cv::Mat ground_side;
+    if (sf.exclude_ground && sf.ground.split_surfaces)
+      mark_ground_side(disparity_, *camera_, ground_plane(), sf.ground.tolerance_m,
+                       sf.ground.side_margin_px, ground_side);
     // The velocities come from the longest gap that knows them: the noise gate uses its span.
     const double span_s =
         spans_s_.empty() ? 0.0 : *std::max_element(spans_s_.begin(), spans_s_.end());
     pool_surface_motion(disparity_, *camera_, p.envelope, sf, span_s, edges_, danger_, ttc_,
-                        velocity_, startup_, yaw_rate_rps_);
+                        velocity_, startup_, yaw_rate_rps_, ground_side);
     startup_ = ChainResiduals{};  // a float a pixel per sample: not kept past the frame
   }
   if (flow_mode_ && sf.grow_into_edges)
     grow_danger_into_edges(disparity_, edges_, sf.edge_margin_px, sf.edge_step_px,
                            p.signal.open_size, danger_, ttc_, velocity_);
-  // Only dangerous pixels are cleared, so only they are tested, and a frame without any needs
-  // no plane (the same masks as testing every pixel).
   if (flow_mode_ && sf.exclude_ground && cv::countNonZero(danger_) > 0) {
-    const GroundPlane plane = fit_ground_plane(disparity_, *camera_, sf.ground);
     cv::Mat ground;
-    mark_ground(disparity_, *camera_, plane, sf.ground.tolerance_m, ground, danger_);
+    mark_ground(disparity_, *camera_, ground_plane(), sf.ground.tolerance_m, ground, danger_);
     danger_.setTo(0, ground);
     ttc_.setTo(std::numeric_limits<float>::quiet_NaN(), ground);
   }

@@ -352,7 +352,11 @@ double slope_doubt(const std::vector<double>& times_s, const std::vector<double>
 void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const core::Envelope& env,
                          const core::SceneFlowParams& p, double span_s, const cv::Mat& edges,
                          cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity,
-                         const ChainResiduals& startup, double yaw_rate_rps) {
+                         const ChainResiduals& startup, double yaw_rate_rps,
+                         const cv::Mat& ground_side) {
+  if (!ground_side.empty() &&
+      (ground_side.type() != CV_8UC1 || ground_side.size() != disp.size()))
+    throw core::InputError("surface motion: the ground side must be CV_8U of the maps' size");
   if (disp.type() != CV_32FC1 || edges.type() != CV_8UC1 || danger.type() != CV_8UC1 ||
       ttc.type() != CV_32FC1 || velocity.type() != CV_32FC3 || edges.size() != disp.size() ||
       danger.size() != disp.size() || ttc.size() != disp.size() || velocity.size() != disp.size())
@@ -388,8 +392,22 @@ void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const cor
   }
   cv::Mat labels;
   // A gap of bridge_m at depth Z = f B / d spans bridge_m f / Z = (bridge_m / B) d rows.
-  const int count = label_surfaces(disp, member, static_cast<float>(p.edge_step_px),
-                                   p.surface_bridge_m / cam.baseline_m, labels);
+  const float step = static_cast<float>(p.edge_step_px);
+  const double bridge = p.surface_bridge_m / cam.baseline_m;
+  int count = 0;
+  if (ground_side.empty()) {
+    count = label_surfaces(disp, member, step, bridge, labels);
+  } else {
+    // Each side labelled on its own, the off side's surfaces numbered after the ground side's.
+    cv::Mat off_member, off_labels;
+    cv::bitwise_and(member, ~ground_side, off_member);
+    cv::bitwise_and(member, ground_side, member);
+    const int on = label_surfaces(disp, member, step, bridge, labels);
+    const int off = label_surfaces(disp, off_member, step, bridge, off_labels);
+    cv::add(off_labels, cv::Scalar(on - 1), off_labels, off_member);
+    off_labels.copyTo(labels, off_member);
+    count = on + off - 1;
+  }
   // Velocity components per surface, in raster order (each surface's values one after another
   // in three flat arrays: a count, then a fill), then their interquartile means.
   const auto surfaces = static_cast<size_t>(count);

@@ -159,6 +159,7 @@ TEST(Params, FlowAndSceneFlowAreValidated) {
   p.scene_flow.edge_margin_px = -1;
   p.scene_flow.exclude_ground = true;
   p.scene_flow.ground.lower_fraction = 0.0;
+  p.scene_flow.ground.side_margin_px = -0.5;
   p.scene_flow.startup_doubt_se = -0.1;
   p.scene_flow.surface_bridge_m = std::numeric_limits<double>::quiet_NaN();
   const auto problems = validate(p, Camera{});
@@ -168,6 +169,7 @@ TEST(Params, FlowAndSceneFlowAreValidated) {
   EXPECT_TRUE(mentions(problems, "scene_flow.gaps=0"));
   EXPECT_TRUE(mentions(problems, "scene_flow.edge_margin_px=-1"));
   EXPECT_TRUE(mentions(problems, "ground.lower_fraction=0"));
+  EXPECT_TRUE(mentions(problems, "ground.side_margin_px=-0.5"));
   // Farneback settings are not checked for DIS; the ground only when it is used.
   p.flow.method = FlowMethod::kDisFast;
   p.scene_flow.exclude_ground = false;

@@ -76,7 +76,7 @@ TEST(Config, FlowAndSceneFlowSections) {
                                "  startup_doubt_se: 1.5\n"
                                "  surface_bridge_m: 0.5\n"
                                "  exclude_ground: true\n"
-                               "  ground: {tolerance_m: 0.1, min_inliers: 50}\n");
+                               "  ground: {tolerance_m: 0.1, min_inliers: 50, side_margin_px: 0.5, split_surfaces: false}\n");
   core::DetectorParams p;
   RunSettings s;
   apply_config_file(path, p, s);
@@ -92,6 +92,8 @@ TEST(Config, FlowAndSceneFlowSections) {
   EXPECT_TRUE(p.scene_flow.exclude_ground);
   EXPECT_DOUBLE_EQ(p.scene_flow.ground.tolerance_m, 0.1);
   EXPECT_EQ(p.scene_flow.ground.min_inliers, 50);
+  EXPECT_DOUBLE_EQ(p.scene_flow.ground.side_margin_px, 0.5);
+  EXPECT_FALSE(p.scene_flow.ground.split_surfaces);
   const core::DetectorParams defaults;
   EXPECT_EQ(p.scene_flow.use_envelope_band, defaults.scene_flow.use_envelope_band);
   EXPECT_EQ(p.stereo.gaps, defaults.stereo.gaps);  // Stereo mode's gaps are another section

@@ -1036,6 +1036,48 @@ TEST(GroundPlane, FitsATiltedGroundAndSparesAnObstacle) {
   EXPECT_GT(cv::countNonZero(part), 100);
 }
 
+// The ground's side: the plane's pixels, the far ground that the matcher reads up to margin_px
+// too near (more than tolerance_m above the plane at a distance), and nothing of what stands
+// on it beyond that. Against the disparity of the plane written out by hand, not mark_ground.
+TEST(GroundPlane, TheGroundSideHoldsTheFarGroundsErrorButNotWhatStandsOnIt) {
+  const core::Camera cam = odd_camera();
+  const double h = 1.0, fb = cam.focal_px * cam.baseline_m;
+  GroundPlane g;
+  g.normal = {0.0, -1.0, 0.0};  // level ground 1 m below the camera: Y = 1
+  g.offset = h;
+  g.found = true;
+  cv::Mat disp(cam.height, cam.width, CV_32F, cv::Scalar(-1.0f));
+  const int y_far = static_cast<int>(cam.cy) + 3, y_near = cam.height - 2;
+  const int x = static_cast<int>(cam.cx);
+  // The plane's disparity at row y: Z = h f / (y - cy).
+  auto ground_d = [&](int y) { return fb * (y - cam.cy) / (cam.focal_px * h); };
+  cv::Mat out;
+  auto side = [&](int y, double d, double margin) {
+    disp.at<float>(y, x) = static_cast<float>(d);
+    mark_ground_side(disp, cam, g, 0.05, margin, out);
+    return out.at<uint8_t>(y, x) != 0;
+  };
+  // Far ground read 0.8 px too near: far above the 5-cm tolerance, inside the 1-px margin.
+  EXPECT_TRUE(side(y_far, ground_d(y_far) + 0.8, 1.0));
+  EXPECT_FALSE(side(y_far, ground_d(y_far) + 0.8, 0.0));
+  EXPECT_FALSE(side(y_far, ground_d(y_far) + 1.2, 1.0));
+  // Near, 3 cm above the plane (tolerance) and below it: ground; 0.3 m above: off it.
+  const double d_near = ground_d(y_near);
+  auto at_height = [&](double above) {  // the disparity of the point `above` m over the plane
+    return d_near * h / (h - above);
+  };
+  EXPECT_TRUE(side(y_near, at_height(0.03), 0.0));
+  EXPECT_TRUE(side(y_near, at_height(-0.2), 0.0));
+  EXPECT_FALSE(side(y_near, at_height(0.3), 1.0));
+  // Above the horizon nothing is on the ground's side; invalid pixels never are.
+  EXPECT_FALSE(side(static_cast<int>(cam.cy) - 5, 2.0, 1.0));
+  EXPECT_FALSE(side(y_near, -1.0, 1.0));
+  // No plane found: nothing.
+  disp.at<float>(y_near, x) = static_cast<float>(d_near);
+  mark_ground_side(disp, cam, GroundPlane{}, 0.05, 1.0, out);
+  EXPECT_EQ(cv::countNonZero(out), 0);
+}
+
 TEST(GroundPlane, NoPlaneWithoutPoints) {
   const core::Camera cam = odd_camera();
   const cv::Mat disp(cam.height, cam.width, CV_32F, cv::Scalar(-1.0f));

@@ -208,6 +208,43 @@ TEST(SlopeDoubt, StandardErrorsOfTheResidualsScatterWidenedForFewSamples) {
   }
 }
 
+// An object standing on the ground meets it at one disparity, so the two are one continuous
+// surface. Pooled together, the larger ground's motion is the object's: a post 3 m ahead walking
+// at 1.2 m/s towards a still camera read as still as the floor it stands on (simulated seed 1095:
+// warned of 2.3 s after it entered the horizon). Surfaces never join the ground's side with
+// what is off it: the post keeps its own motion, the floor its own.
+TEST(PoolSurfaceMotion, AnObjectStandingOnTheGroundKeepsItsOwnMotion) {
+  const core::SceneFlowParams p;
+  const cv::Rect post(70, 20, 8, 60), floor(10, 80, 140, 30);
+  auto run = [&](bool with_side) {
+    Maps m;
+    cv::RNG rng(31);
+    m.patch(post, 3.0, {0, 0, -1.2}, 0.05, rng);
+    m.patch(floor, 3.0, {0, 0, 0}, 0.05, rng);  // its near row, the post's foot, at the same depth
+    cv::Mat side;
+    if (with_side) {
+      side = cv::Mat::zeros(m.disp.size(), CV_8U);
+      side(floor).setTo(255);
+    }
+    pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc, m.velocity,
+                        {}, 0.0, side);
+    return m;
+  };
+  const Maps joined = run(false);
+  EXPECT_EQ(cv::countNonZero(joined.danger), 0);
+  EXPECT_NEAR(joined.velocity.at<cv::Vec3f>(50, 73)[2], 0.0, 0.05);
+  const Maps apart = run(true);
+  EXPECT_EQ(cv::countNonZero(apart.danger(post)), post.area());
+  EXPECT_EQ(cv::countNonZero(apart.danger), post.area());
+  EXPECT_NEAR(apart.velocity.at<cv::Vec3f>(50, 73)[2], -1.2, 0.05);
+  EXPECT_NEAR(apart.velocity.at<cv::Vec3f>(95, 73)[2], 0.0, 0.05);
+  // A mask of another size is an error, not a silent misreading.
+  Maps m;
+  EXPECT_THROW(pool_surface_motion(m.disp, camera(), wide(), p, 2.0, m.edges, m.danger, m.ttc,
+                                   m.velocity, {}, 0.0, cv::Mat::zeros(10, 10, CV_8U)),
+               core::InputError);
+}
+
 // Velocities from quantized disparities cluster on a few values; the pooled velocity must average
 // over them (here 40 % read -2.1 and 60 % -2.0 m/s, mean -2.04), not snap to one as a median does.
 TEST(PoolSurfaceMotion, PooledVelocityIsNotStuckToTheQuantizationGrid) {

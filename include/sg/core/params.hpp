@@ -189,6 +189,13 @@ struct GroundParams {
   double z_max_m = 12.0;        ///< ignore points farther than this, m
   int min_inliers = 200;        ///< fewer inliers: no plane found
   std::uint64_t seed = 12345;   ///< fixed RANSAC seed (reproducible)
+  /// With pool_surface_motion, no surface joins the ground's side (mark_ground_side) with what is
+  /// off it, so that an object standing on the ground keeps its own motion.
+  bool split_surfaces = true;
+  /// A pixel whose disparity exceeds the plane's at that pixel by at most this, px (>= 0), is on
+  /// the ground's side. About the matcher's error on a textured road, so that the road's
+  /// mismatched patches stay with the road.
+  double side_margin_px = 1.0;
 };
 
 /// Stereo-Flow pixel labelling (DESIGN 3.2): the 3D motion heads into the envelope.
@@ -318,7 +325,8 @@ struct SceneFlowParams {
   bool use_envelope_band = true;
   /// Clear dangerous pixels on or below a fitted ground plane: the ground is never an obstacle,
   /// yet an envelope that reaches below the camera's height (a robot preset 1.0 m deep on a
-  /// camera 0.5 m high), a tilt, or flow lost on a fast road make it read as approaching.
+  /// camera 0.5 m high), a tilt, or flow lost on a fast road make it read as approaching. Its
+  /// plane also splits the surfaces of pool_surface_motion (GroundParams::split_surfaces).
   bool exclude_ground = true;
   GroundParams ground;  ///< the fit used by exclude_ground
 };

@@ -178,4 +178,13 @@ GroundPlane fit_ground_plane(const cv::Mat& disp, const core::Camera& cam, const
 void mark_ground(const cv::Mat& disp, const core::Camera& cam, const GroundPlane& plane,
                  double tolerance_m, cv::Mat& mask, const cv::Mat& only = cv::Mat());
 
+/// 255 on the ground's side of the plane: where the pixel's 3D point lies within `tolerance_m`
+/// of the plane or below it, or where its disparity exceeds the plane's disparity at that pixel
+/// by at most `margin_px` (the matcher's error on the ground, which at a distance is more than
+/// tolerance_m); 0 elsewhere, where the disparity is invalid, and everywhere when no plane was
+/// found. mask: CV_8U, allocated. pool_surface_motion joins no pixel of this side with one off it:
+/// an object standing on the ground meets it at one disparity.
+void mark_ground_side(const cv::Mat& disp, const core::Camera& cam, const GroundPlane& plane,
+                      double tolerance_m, double margin_px, cv::Mat& mask);
+
 }  // namespace sg::vision

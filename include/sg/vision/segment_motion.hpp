@@ -104,10 +104,14 @@ double slope_doubt(const std::vector<double>& times_s, const std::vector<double>
 /// when that is <= 0; nothing either with fewer than three samples); the TTC reported is that of
 /// V itself. A large surface seen well is thus trusted from its first frames, a few pixels whose
 /// disparity steps are not. yaw_rate_rps (rad/s, + = turning right): the platform's turn, which
-/// the envelope test follows (heads_into_envelope_turning); 0 = straight ahead.
+/// the envelope test follows (heads_into_envelope_turning); 0 = straight ahead. ground_side
+/// (optional, CV_8U of the maps' size; InputError otherwise; mark_ground_side): no surface joins
+/// a nonzero pixel with a zero one. An object standing on the ground meets it at one disparity;
+/// without it the two pool as one surface, and the larger ground's motion becomes the object's.
 void pool_surface_motion(const cv::Mat& disp, const core::Camera& cam, const core::Envelope& env,
                          const core::SceneFlowParams& p, double span_s, const cv::Mat& edges,
                          cv::Mat& danger, cv::Mat& ttc, cv::Mat& velocity,
-                         const ChainResiduals& startup = {}, double yaw_rate_rps = 0.0);
+                         const ChainResiduals& startup = {}, double yaw_rate_rps = 0.0,
+                         const cv::Mat& ground_side = cv::Mat());
 
 }  // namespace sg::vision
