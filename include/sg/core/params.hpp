@@ -264,22 +264,11 @@ struct SceneFlowParams {
   /// velocity (simulated thin-pole: the top 0.3 m of the pole, cut off by 0.25 m matched to the
   /// wall, pooled -1.60 m/s for a true -1.40: an early alarm). 0 joins only neighbours, m.
   double surface_bridge_m = 0.3;
-  /// With pool_surface_motion, candidates nearer than chain_stride_z_m (> 0) are followed back
-  /// along the flow chain only on every chain_stride-th row and column (1..8; 1 = all of them):
-  /// their surfaces' velocities are pooled and tested at every pixel anyway, and a near object
-  /// has thousands of pixels (a 1 m box 4 m away: 15000 at f = 500 px). Following every one was
-  /// the labelling cost that grew as an object came near (head-on frame 135: 117 ms a frame).
-  /// Each sqrt(2) nearer doubles one stride (up to 16), columns first, then rows: nearer than
-  /// chain_stride_z_m / sqrt(2) every (2 chain_stride)-th column, nearer than chain_stride_z_m / 2
-  /// every (2 chain_stride)-th column and row, and so on, so the pixels followed stay about as
-  /// many as the object nears (head-on folder, one frame at a time: frames 130-138 cost 39-56 ms
-  /// with one stride, 27-36 ms with chain_stride 4; no eval figure of the built-in scenarios
-  /// moved). A step at every sqrt(2), not only at each halving: the labelling of head-on frames
-  /// 120-129 took 4.6 ms a frame, now 3.8 (2.7 far; one thread, head-on folder). From 8 m, not
-  /// 4: a box between 4 and 8 m was followed at every pixel and made the costliest frames before
-  /// contact (frames 100-119: 25-31 ms against 17 ms far; from 8 m: 21-25 ms), the tail that
-  /// paced runs wait for; the eval figures stayed but for TTC p90 on thin-pole (0.037 -> 0.054).
-  /// pool_surface_motion weighs each followed pixel by the pixels of its cell (ChainStrides).
+  /// With pool_surface_motion, candidates nearer than chain_stride_z_m (m, > 0) are followed back
+  /// along the flow chain only on every chain_stride-th row and column (1..8; 1 = all of them),
+  /// the stride doubled at every factor sqrt(2) nearer, columns first, up to 16 (ChainStrides).
+  /// Their surfaces' velocities are pooled and tested at every pixel anyway, so the labelling
+  /// costs about as much near as far. Why 2 from 8 m: docs/decisions/chain-stride.md.
   int chain_stride = 2;
   double chain_stride_z_m = 8.0;
   /// Grow each dangerous blob back over the depth-edge margin (pixels of similar disparity next
