@@ -283,10 +283,7 @@ struct SceneFlowParams {
   /// depth-independent; vision/ego_motion.hpp) and P_{i-k} is turned into frame i's orientation.
   /// Needed when the platform turns or sways while it moves: on exact maps, driving at 3 m/s
   /// while turning at 10 deg/s makes boxes beside the path look as if they cut in (compensated:
-  /// none); a hand-carried or walking camera sways. It used to be off because, turning in place
-  /// at 30 deg/s with BM + DIS, it exposed chained-flow mismatches (simulated turning:
-  /// false_alarm_rate 0.020); with the left-right check and obstacle confirmation it gives none
-  /// there, and no built-in scenario or shared recording loses an alarm frame with it.
+  /// none); a hand-carried or walking camera sways. Why on: docs/decisions/compensate-rotation.md.
   bool compensate_rotation = true;
   /// With compensate_rotation: the envelope test follows the platform's turn (the yaw rate of
   /// that rotation estimate over the longest gap): a point is dangerous when it meets the contact
