@@ -617,24 +617,19 @@ void mark_ground(const cv::Mat& disp, const core::Camera& cam, const GroundPlane
 
 void mark_ground_side(const cv::Mat& disp, const core::Camera& cam, const GroundPlane& plane,
                       double tolerance_m, double margin_px, cv::Mat& mask) {
-  if (disp.type() != CV_32FC1) throw core::InputError("ground side: disparity must be CV_32F");
-  mask.create(disp.size(), CV_8UC1);
-  mask.setTo(0);
+  mark_ground(disp, cam, plane, tolerance_m, mask);  // on or below the plane; all 0 without one
   if (!plane.found) return;
-  // n . P + c = 0 with P = (B / d) (x - cx, y - cy, f): with r = n . (x - cx, y - cy, f), linear
-  // along a row, the plane's disparity at (x, y) is d_g = -B r / c, and the point lies within
-  // tolerance of the plane or below it when B r / d + c <= tolerance, i.e. B r <= (tol - c) d.
+  // With P = (B / d) (x - cx, y - cy, f) in n . P + c = 0, the plane's disparity at (x, y) is
+  // d_g = -B n . (x - cx, y - cy, f) / c, linear along a row.
   const cv::Vec3d& n = plane.normal;
-  const double B = cam.baseline_m, k = -B / plane.offset, tol_c = tolerance_m - plane.offset;
+  const double k = -cam.baseline_m / plane.offset;
   for (int y = 0; y < disp.rows; ++y) {
     const float* row = disp.ptr<float>(y);
     uint8_t* out = mask.ptr<uint8_t>(y);
     const double row_part = n[1] * (y - cam.cy) + n[2] * cam.focal_px;
-    for (int x = 0; x < disp.cols; ++x) {
-      const double d = row[x];
-      const double r = n[0] * (x - cam.cx) + row_part;
-      out[x] = d > 0.0 && (d <= k * r + margin_px || B * r <= tol_c * d) ? 255 : 0;
-    }
+    for (int x = 0; x < disp.cols; ++x)
+      if (row[x] > 0.0f && row[x] <= k * (n[0] * (x - cam.cx) + row_part) + margin_px)
+        out[x] = 255;
   }
 }
 

@@ -76,7 +76,8 @@ TEST(Config, FlowAndSceneFlowSections) {
                                "  startup_doubt_se: 1.5\n"
                                "  surface_bridge_m: 0.5\n"
                                "  exclude_ground: true\n"
-                               "  ground: {tolerance_m: 0.1, min_inliers: 50, side_margin_px: 0.5, split_surfaces: false}\n");
+                               "  ground: {tolerance_m: 0.1, min_inliers: 50, side_margin_px: 0.5,\n"
+                               "           split_surfaces: false}\n");
   core::DetectorParams p;
   RunSettings s;
   apply_config_file(path, p, s);
