@@ -243,6 +243,10 @@ std::vector<std::string> validate(const SceneFlowParams& p) {
             "must exceed v_min_mps");
   c.require(std::isfinite(p.startup_doubt_se) && p.startup_doubt_se >= 0, "startup_doubt_se",
             p.startup_doubt_se, "must be >= 0");
+  c.require(std::isfinite(p.chain_outlier_px) && p.chain_outlier_px >= 0, "chain_outlier_px",
+            p.chain_outlier_px, "must be >= 0 (0 disables)");
+  c.require(std::isfinite(p.chain_outlier_fraction) && p.chain_outlier_fraction >= 0,
+            "chain_outlier_fraction", p.chain_outlier_fraction, "must be >= 0");
   c.require(std::isfinite(p.surface_bridge_m) && p.surface_bridge_m >= 0 &&
                 p.surface_bridge_m <= 5.0,
             "surface_bridge_m", p.surface_bridge_m, "must be in 0..5");

@@ -202,6 +202,8 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("z_max_m", p.scene_flow.z_max_m)
         .field("min_delta_d_px", p.scene_flow.min_delta_d_px)
         .field("max_speed_mps", p.scene_flow.max_speed_mps)
+        .field("chain_outlier_px", p.scene_flow.chain_outlier_px)
+        .field("chain_outlier_fraction", p.scene_flow.chain_outlier_fraction)
         .field("startup_doubt_se", p.scene_flow.startup_doubt_se)
         .field("max_disparity_step_px", p.scene_flow.max_disparity_step_px)
         .field("edge_margin_px", p.scene_flow.edge_margin_px)

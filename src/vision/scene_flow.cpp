@@ -133,6 +133,30 @@ struct VelocityFit {
   }
 };
 
+/// Whether a sample of a velocity fit's chain is an outlier: its disparity departs from the
+/// line fitted through the chain's other samples by more than p.chain_outlier_px and more than
+/// p.chain_outlier_fraction of its own disparity. z[j], t[j], w[j] (j < slots; z NaN: no
+/// sample) are each sample's depth, time and weight in `f`. A repetitive texture matched one
+/// period off in some frames, or a flow that slid onto another surface, steps by whole pixels;
+/// the matcher's noise stays under the pixel bound, a smooth change of speed under the fraction.
+bool chain_has_outlier(const VelocityFit& f, const float* z, const double* t, const double* w,
+                       int slots, double fb, const SceneFlowParams& p) {
+  if (f.n < 3) return false;  // two samples left make a line through both: nothing to test
+  for (int j = 0; j < slots; ++j) {
+    if (std::isnan(z[j])) continue;
+    const double sw = f.sw - w[j], st = f.st - w[j] * t[j], stt = f.stt - w[j] * t[j] * t[j];
+    const double sz = f.sp[2] - w[j] * z[j], stz = f.stp[2] - w[j] * t[j] * z[j];
+    const double tb = st / sw, spread = stt - st * tb;
+    if (!(sw > 0.0) || !(spread > 1e-12)) continue;  // the others share one time
+    const double line = sz / sw + (stz - tb * sz) / spread * (t[j] - tb);
+    if (!(line > 0.0)) return true;  // the others' line leaves the space before the camera
+    const double d = fb / z[j];
+    if (std::abs(d - fb / line) > std::max(p.chain_outlier_px, p.chain_outlier_fraction * d))
+      return true;
+  }
+  return false;
+}
+
 /// mark_depth_edges at one pixel: the valid disparities of the window around (x, y) span more
 /// than `step`. Used for the past source q of the few pixels that pass every other test.
 bool near_depth_edge(const cv::Mat& disp, int x, int y, int r, float step) {
@@ -418,6 +442,13 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
   live.reserve(disp_cur.cols);
   candidates.reserve(disp_cur.cols);
   std::vector<VelocityFit> fits(p.fit_velocity ? disp_cur.cols : 0);
+  // Each followed pixel's depth and weight at each sample time of its fit (depth NaN: no
+  // sample), for the outlier test and the residuals; the sample times.
+  std::vector<float> depths(p.fit_velocity ? static_cast<size_t>(slots) * disp_cur.cols : 0);
+  std::vector<double> weights(depths.size()), times(static_cast<size_t>(slots), 0.0);
+  for (int j = 1; j < slots; ++j) times[static_cast<size_t>(j)] = -gaps[static_cast<size_t>(j - 1)].span_s;
+  const bool outlier_test = p.chain_outlier_px > 0.0;
+  const double fb = cam.focal_px * cam.baseline_m;
   for (int y = r.start; y < r.end; ++y) {
     const float* d_row = disp_cur.ptr<float>(y);
     const uint8_t* edge_row = edges_cur.ptr<uint8_t>(y);
@@ -436,7 +467,13 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
           strides.followed(x, y, d_row[x]) && (!p.use_envelope_band || in_band(y, d_row[x]))) {
         q[x] = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
         live.push_back(x);
-        if (p.fit_velocity) fits[x].reset(test.point(static_cast<float>(x), fy, d_row[x]));
+        if (p.fit_velocity) {
+          fits[x].reset(test.point(static_cast<float>(x), fy, d_row[x]));
+          float* z = &depths[static_cast<size_t>(x) * slots];
+          std::fill(z, z + slots, kNaN);
+          z[0] = static_cast<float>(fits[x].now[2]);
+          weights[static_cast<size_t>(x) * slots] = 1.0;
+        }
       }
     }
     if (p.fit_velocity) candidates = live;
@@ -467,8 +504,10 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
           if (g.derotate) P = *g.derotate * P;
           // Weight 1 / var(Z) relative to now's: Z's error grows as Z^2 = (f B / d)^2.
           const double rel = static_cast<double>(d_prev) / d_row[x];
-          fits[x].add(-g.span_s, P, rel * rel * rel * rel);
-          if (res_row) res_row[x * slots + static_cast<int>(gi) + 1] = static_cast<float>(P[2]);
+          const double w = rel * rel * rel * rel;
+          fits[x].add(-g.span_s, P, w);
+          depths[static_cast<size_t>(x) * slots + gi + 1] = static_cast<float>(P[2]);
+          weights[static_cast<size_t>(x) * slots + gi + 1] = w;
         }
         continue;
       }
@@ -502,24 +541,28 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
     if (!p.fit_velocity) continue;
     for (const int x : candidates) {
       cv::Vec3d V;
+      float* r_px = res_row ? res_row + x * slots : nullptr;
       if (!fits[x].slope(V)) {
-        if (res_row) std::fill_n(res_row + x * slots, slots, kNaN);
+        if (r_px) std::fill_n(r_px, slots, kNaN);
         continue;
       }
-      const GapResult res = test.verdict(fits[x].now, d_row[x], V, fits[x].span_s);
+      // Z's distance from the fitted line at each sample: now, then the past frames' samples.
+      const VelocityFit& f = fits[x];
+      const double tb = f.st / f.sw, zb = f.sp[2] / f.sw;
+      const float* z = &depths[static_cast<size_t>(x) * slots];
+      auto fitted = [&](int j) { return zb + V[2] * (times[static_cast<size_t>(j)] - tb); };
+      if (outlier_test && chain_has_outlier(f, z, times.data(),
+                                            &weights[static_cast<size_t>(x) * slots], slots, fb, p)) {
+        if (r_px) std::fill_n(r_px, slots, kNaN);
+        continue;  // a mismatch on the chain: the velocity is unknown
+      }
+      const GapResult res = test.verdict(f.now, d_row[x], V, f.span_s);
       danger_row[x] = res.dangerous ? 255 : 0;
       ttc_row[x] = res.dangerous ? static_cast<float>(res.ttc) : kNaN;
       vel_row[x] = cv::Vec3f(res.velocity);
-      if (!res_row) continue;
-      // Z's distance from the fitted line at each sample: now, then the samples recorded above.
-      const VelocityFit& f = fits[x];
-      const double tb = f.st / f.sw, zb = f.sp[2] / f.sw;
-      float* r_px = res_row + x * slots;
-      r_px[0] = static_cast<float>(f.now[2] - zb + V[2] * tb);
-      for (int j = 1; j < slots; ++j)
-        if (!std::isnan(r_px[j]))
-          r_px[j] = static_cast<float>(r_px[j] - zb +
-                                       V[2] * (gaps[static_cast<size_t>(j - 1)].span_s + tb));
+      if (r_px)
+        for (int j = 0; j < slots; ++j)
+          r_px[j] = std::isnan(z[j]) ? kNaN : static_cast<float>(z[j] - fitted(j));
     }
   }
 }

@@ -161,9 +161,13 @@ TEST(Params, FlowAndSceneFlowAreValidated) {
   p.scene_flow.ground.lower_fraction = 0.0;
   p.scene_flow.ground.side_margin_px = -0.5;
   p.scene_flow.startup_doubt_se = -0.1;
+  p.scene_flow.chain_outlier_px = -1.0;
+  p.scene_flow.chain_outlier_fraction = std::numeric_limits<double>::infinity();
   p.scene_flow.surface_bridge_m = std::numeric_limits<double>::quiet_NaN();
   const auto problems = validate(p, Camera{});
   EXPECT_TRUE(mentions(problems, "scene_flow.startup_doubt_se=-0.1"));
+  EXPECT_TRUE(mentions(problems, "scene_flow.chain_outlier_px=-1"));
+  EXPECT_TRUE(mentions(problems, "scene_flow.chain_outlier_fraction=inf"));
   EXPECT_TRUE(mentions(problems, "scene_flow.surface_bridge_m=nan"));
   EXPECT_TRUE(mentions(problems, "flow.fb_poly_n=6"));
   EXPECT_TRUE(mentions(problems, "scene_flow.gaps=0"));

@@ -75,6 +75,8 @@ TEST(Config, FlowAndSceneFlowSections) {
                                "  longest_gap_decides: false\n"
                                "  startup_doubt_se: 1.5\n"
                                "  surface_bridge_m: 0.5\n"
+                               "  chain_outlier_px: 3\n"
+                               "  chain_outlier_fraction: 0.4\n"
                                "  exclude_ground: true\n"
                                "  ground: {tolerance_m: 0.1, min_inliers: 50, side_margin_px: 0.5,\n"
                                "           split_surfaces: false}\n");
@@ -90,6 +92,8 @@ TEST(Config, FlowAndSceneFlowSections) {
   EXPECT_FALSE(p.scene_flow.longest_gap_decides);
   EXPECT_DOUBLE_EQ(p.scene_flow.startup_doubt_se, 1.5);
   EXPECT_DOUBLE_EQ(p.scene_flow.surface_bridge_m, 0.5);
+  EXPECT_DOUBLE_EQ(p.scene_flow.chain_outlier_px, 3.0);
+  EXPECT_DOUBLE_EQ(p.scene_flow.chain_outlier_fraction, 0.4);
   EXPECT_TRUE(p.scene_flow.exclude_ground);
   EXPECT_DOUBLE_EQ(p.scene_flow.ground.tolerance_m, 0.1);
   EXPECT_EQ(p.scene_flow.ground.min_inliers, 50);

@@ -477,18 +477,41 @@ NaiveOut naive_fit_pixel(int x, int y, const cv::Mat& cur, const std::vector<cv:
     ps.push_back(point(qx, qy, dp));
   }
   if (ts.size() < 2) return out;
-  double sw = 0, tm = 0;
-  cv::Vec3d pm(0, 0, 0);
-  for (size_t i = 0; i < ts.size(); ++i) sw += ws[i], tm += ws[i] * ts[i], pm += ws[i] * ps[i];
-  tm /= sw;
-  pm /= sw;
-  double stt = 0;
-  cv::Vec3d stp(0, 0, 0);
-  for (size_t i = 0; i < ts.size(); ++i) {
-    stt += ws[i] * (ts[i] - tm) * (ts[i] - tm);
-    stp += ws[i] * (ts[i] - tm) * (ps[i] - pm);
-  }
-  const cv::Vec3d V = stp / stt;
+  // The weighted least-squares line through the samples but `skip` (-1: none): mean time,
+  // mean position, slope.
+  auto line = [&](int skip, double& tm, cv::Vec3d& pm, cv::Vec3d& slope) {
+    double sw = 0;
+    tm = 0;
+    pm = cv::Vec3d(0, 0, 0);
+    for (size_t i = 0; i < ts.size(); ++i)
+      if (static_cast<int>(i) != skip) sw += ws[i], tm += ws[i] * ts[i], pm += ws[i] * ps[i];
+    tm /= sw;
+    pm /= sw;
+    double stt = 0;
+    cv::Vec3d stp(0, 0, 0);
+    for (size_t i = 0; i < ts.size(); ++i)
+      if (static_cast<int>(i) != skip) {
+        stt += ws[i] * (ts[i] - tm) * (ts[i] - tm);
+        stp += ws[i] * (ts[i] - tm) * (ps[i] - pm);
+      }
+    slope = stp / stt;
+    return stt > 1e-12;
+  };
+  // An outlier: a sample's disparity off the line through the others by more than both bounds.
+  if (p.chain_outlier_px > 0 && ts.size() >= 3)
+    for (size_t j = 0; j < ts.size(); ++j) {
+      double tm;
+      cv::Vec3d pm, slope;
+      if (!line(static_cast<int>(j), tm, pm, slope)) continue;
+      const double z_line = pm[2] + slope[2] * (ts[j] - tm);
+      const double dj = fb / ps[j][2];
+      if (!(z_line > 0) ||
+          std::abs(dj - fb / z_line) > std::max(p.chain_outlier_px, p.chain_outlier_fraction * dj))
+        return out;  // velocity unknown
+    }
+  double tm;
+  cv::Vec3d pm, V;
+  line(-1, tm, pm, V);
   out.vel = V;
   const cv::Vec3d& P = ps[0];
   const double z_before = P[2] - V[2] * -ts.back();
@@ -824,6 +847,51 @@ TEST_F(FarApproach, TheFitFindsTheExactVelocityWithoutErrors) {
   EXPECT_NEAR(vel_.at<cv::Vec3f>(75, 100)[2], -3.0, 0.02);
   const cv::Rect centre(90, 65, 21, 21);
   EXPECT_EQ(cv::countNonZero(danger_(centre)), centre.area());
+}
+
+// One frame of the chain matched one period of a repetitive texture off (+3 px of 6.67, a
+// checkerboard read nearer): the fit would take it for motion.
+TEST_F(FarApproach, AMismatchedFrameOnTheChainLeavesTheVelocityUnknown) {
+  disps_[4](square(9.0 + 3.0 * kDt * 4)) += 3.0f;
+  label({10}, 10, true);
+  EXPECT_TRUE(std::isnan(vel_.at<cv::Vec3f>(75, 100)[2]));
+  // Inside the square every chain sampled the mismatch (at its border the bilinear sample mixes
+  // the wall in and is skipped: those chains never saw it).
+  const cv::Rect centre(90, 65, 21, 21);
+  EXPECT_EQ(cv::countNonZero(danger_(centre)), 0);
+  // The same in the current frame: nothing before it supports it.
+  disps_[4](square(9.0 + 3.0 * kDt * 4)) -= 3.0f;
+  disps_[0](square(9.0)) += 3.0f;
+  label({10}, 10, true);
+  EXPECT_TRUE(std::isnan(vel_.at<cv::Vec3f>(75, 100)[2]));
+}
+
+// The bounds: under chain_outlier_px (far) or under chain_outlier_fraction (near) a step stays
+// in the fit.
+TEST_F(FarApproach, StepsWithinEitherBoundStayInTheFit) {
+  SceneFlowParams p = plain();
+  p.gaps = {10};
+  p.fit_velocity = true;
+  disps_[4](square(9.0 + 3.0 * kDt * 4)) += 1.5f;  // 1.5 px < 2 px, though 23 % of the disparity
+  std::vector<const cv::Mat*> d, f;
+  for (int j = 0; j < 10; ++j) {
+    d.push_back(&disps_[j + 1]);
+    f.push_back(&flows_[j]);
+  }
+  label_stereo_flow_window(disps_[0], d, f, cam_, {}, p, kDt, danger_, ttc_, vel_);
+  EXPECT_FALSE(std::isnan(vel_.at<cv::Vec3f>(75, 100)[2]));
+  // The sample reads 7.9 px: 1.5 px is beyond both 1 px and 15 % of 7.9 px (1.2 px).
+  p.chain_outlier_px = 1.0;
+  p.chain_outlier_fraction = 0.15;
+  label_stereo_flow_window(disps_[0], d, f, cam_, {}, p, kDt, danger_, ttc_, vel_);
+  EXPECT_TRUE(std::isnan(vel_.at<cv::Vec3f>(75, 100)[2]));
+  p.chain_outlier_fraction = 0.25;  // 25 % of 7.9 px (2.0 px): within the fraction
+  label_stereo_flow_window(disps_[0], d, f, cam_, {}, p, kDt, danger_, ttc_, vel_);
+  EXPECT_FALSE(std::isnan(vel_.at<cv::Vec3f>(75, 100)[2]));
+  p.chain_outlier_px = 0.0;  // disabled
+  p.chain_outlier_fraction = 0.0;
+  label_stereo_flow_window(disps_[0], d, f, cam_, {}, p, kDt, danger_, ttc_, vel_);
+  EXPECT_FALSE(std::isnan(vel_.at<cv::Vec3f>(75, 100)[2]));
 }
 
 TEST_F(FarApproach, GapTenNeedsTenFrames) {

@@ -218,18 +218,24 @@ struct SceneFlowParams {
   /// a noise gate, as in Stereo mode; 0 disables it.
   double min_delta_d_px = 0.5;
   /// Until the velocity fit's chain reaches the longest gap (the first frames of a stream), the
-  /// disparity error dominates the fit (simulated thin-pole, 4 frames at 7.6 m: -5.8 m/s for a
-  /// true -1.4): the envelope test then uses the slowest approach along the measured path that
-  /// this many standard errors of the surface's velocity could hide, V (1 - sigma_V / -V_z).
-  /// The standard error is the one the data show: the scatter of the surface's mean residuals
-  /// about its fitted line (pool_surface_motion, slope_doubt), widened as Student's t for few
-  /// samples; none is trusted before three samples. A large surface seen well is trusted at once
-  /// (cold-start: the box alarms at frame 7, as with no doubt, instead of 15 with an assumed
-  /// 0.6 px error), a pole whose disparity steps is not (thin-pole false_alarm_rate 0.014; with
-  /// no doubt 0.082). 0 trusts the first frames fully.
+  /// envelope test uses the slowest approach along the measured path that this many standard
+  /// errors of the surface's velocity could hide, V (1 - sigma_V / -V_z), >= 0. The standard
+  /// error is the scatter of the surface's mean residuals about its fitted line
+  /// (pool_surface_motion, slope_doubt), widened as Student's t; none is trusted before three
+  /// samples. Why from the data, not an assumed error: docs/decisions/startup-doubt.md.
+  /// 0 trusts the first frames fully.
   double startup_doubt_se = 2.0;
   /// Velocities faster than this are mismatches and are ignored, m/s.
   double max_speed_mps = 40.0;
+  /// With fit_velocity, a chain with a sample whose disparity departs from the line fitted
+  /// through its other samples by more than chain_outlier_px (px) and more than
+  /// chain_outlier_fraction of its own disparity crossed a mismatch: its velocity is unknown. A
+  /// repetitive texture matched one period off in some frames (a checkerboard 2.6 m away read at
+  /// 1.6 m in some frames, 20 px against 32) or a flow that slid onto another surface steps by
+  /// whole pixels; the matcher's noise stays under the pixel bound, a smooth change of speed
+  /// under the fraction. chain_outlier_px 0 disables; the fraction is >= 0.
+  double chain_outlier_px = 2.0;
+  double chain_outlier_fraction = 0.25;
   /// The past disparity D_{i-k}(q) is unknown when the neighbours its bilinear sample uses differ
   /// by more than this, px: at a depth edge the mix of object and background would look like a
   /// fast approach. Infinity disables the check.
@@ -258,11 +264,9 @@ struct SceneFlowParams {
   /// velocities its candidates know.
   bool pool_surface_motion = true;
   /// With pool_surface_motion, a surface also continues down a column past a stretch of at most
-  /// this many metres (at its depth) where the matcher read something else, and resumes at a
-  /// disparity within edge_step_px: the block window mixes a thin pole with the background
-  /// behind it, so the matcher breaks it into pieces, and a small piece alone pools a biased
-  /// velocity (simulated thin-pole: the top 0.3 m of the pole, cut off by 0.25 m matched to the
-  /// wall, pooled -1.60 m/s for a true -1.40: an early alarm). 0 joins only neighbours, m.
+  /// this many metres (at its depth, 0..5) where the matcher read something else, and resumes at
+  /// a disparity within edge_step_px, so that the pieces of a thin pole the block window broke
+  /// apart pool as one. Why 0.3: docs/decisions/surface-bridge.md. 0 joins only neighbours.
   double surface_bridge_m = 0.3;
   /// With pool_surface_motion, candidates nearer than chain_stride_z_m (m, > 0) are followed back
   /// along the flow chain only on every chain_stride-th row and column (1..8; 1 = all of them),
@@ -272,11 +276,8 @@ struct SceneFlowParams {
   int chain_stride = 2;
   double chain_stride_z_m = 8.0;
   /// Grow each dangerous blob back over the depth-edge margin (pixels of similar disparity next
-  /// to it, up to edge_margin_px rounds) before the clean-up's min_area: the margin otherwise
-  /// shrinks a far object below min_area (a car 30 m away keeps 20 x 14 of its 36 x 30 px).
-  /// Off by default: it also grows the blobs whose TTC is just under the horizon a little early,
-  /// and those of boxes passing beside the envelope (simulated two-obstacles: false_alarm_rate
-  /// 0.469 with it; head-on-fast 0.281; car-stopped keeps its 2.5 s lead without it).
+  /// to it, up to edge_margin_px rounds) before the clean-up's min_area, so that the margin
+  /// cannot shrink a far object below min_area. Why off: docs/decisions/grow-into-edges.md.
   bool grow_into_edges = false;
   /// Remove the camera's own rotation before the envelope test: the rotation between frames is
   /// estimated from the background flow (with disparity known, rotation flow is
