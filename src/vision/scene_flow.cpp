@@ -446,7 +446,7 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
   // sample), for the outlier test and the residuals; the sample times.
   std::vector<float> depths(p.fit_velocity ? static_cast<size_t>(slots) * disp_cur.cols : 0);
   std::vector<double> weights(depths.size()), times(static_cast<size_t>(slots), 0.0);
-  for (int j = 1; j < slots; ++j) times[static_cast<size_t>(j)] = -gaps[static_cast<size_t>(j - 1)].span_s;
+  for (size_t j = 1; j < times.size(); ++j) times[j] = -gaps[j - 1].span_s;
   const bool outlier_test = p.chain_outlier_px > 0.0;
   const double fb = cam.focal_px * cam.baseline_m;
   for (int y = r.start; y < r.end; ++y) {
@@ -551,8 +551,8 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
       const double tb = f.st / f.sw, zb = f.sp[2] / f.sw;
       const float* z = &depths[static_cast<size_t>(x) * slots];
       auto fitted = [&](int j) { return zb + V[2] * (times[static_cast<size_t>(j)] - tb); };
-      if (outlier_test && chain_has_outlier(f, z, times.data(),
-                                            &weights[static_cast<size_t>(x) * slots], slots, fb, p)) {
+      const double* w = &weights[static_cast<size_t>(x) * slots];
+      if (outlier_test && chain_has_outlier(f, z, times.data(), w, slots, fb, p)) {
         if (r_px) std::fill_n(r_px, slots, kNaN);
         continue;  // a mismatch on the chain: the velocity is unknown
       }
