@@ -133,16 +133,49 @@ struct VelocityFit {
   }
 };
 
-/// Whether a sample of a velocity fit's chain is an outlier: its disparity departs from the
+/// Each followed pixel's samples of one row's velocity fits: its depth and weight at each sample
+/// time (depth NaN: no sample), for the outlier test and the residuals. Slot 0 is now, slot
+/// gi + 1 the gi-th gap's frame.
+struct ChainSamples {
+  int slots = 0;
+  std::vector<double> times;  ///< per slot, s (<= 0)
+  std::vector<float> depths;  ///< per pixel, then slot, m
+  std::vector<double> weights;
+
+  ChainSamples(const std::vector<GapSource>& gaps, int cols)
+      : slots(1 + static_cast<int>(gaps.size())),
+        times(static_cast<size_t>(slots), 0.0),
+        depths(static_cast<size_t>(slots) * cols),
+        weights(depths.size()) {
+    for (size_t j = 1; j < times.size(); ++j) times[j] = -gaps[j - 1].span_s;
+  }
+  float* depth(int x) { return &depths[static_cast<size_t>(x) * slots]; }
+  const float* depth(int x) const { return &depths[static_cast<size_t>(x) * slots]; }
+  const double* weight(int x) const { return &weights[static_cast<size_t>(x) * slots]; }
+  void start(int x, double z_now) {
+    float* z = depth(x);
+    std::fill(z, z + slots, kNaN);
+    z[0] = static_cast<float>(z_now);
+    weights[static_cast<size_t>(x) * slots] = 1.0;
+  }
+  void add(int x, size_t gi, double z, double w) {
+    depths[static_cast<size_t>(x) * slots + gi + 1] = static_cast<float>(z);
+    weights[static_cast<size_t>(x) * slots + gi + 1] = w;
+  }
+};
+
+/// Whether a sample of pixel x's velocity fit `f` is an outlier: its disparity departs from the
 /// line fitted through the chain's other samples by more than p.chain_outlier_px and more than
-/// p.chain_outlier_fraction of its own disparity. z[j], t[j], w[j] (j < slots; z NaN: no
-/// sample) are each sample's depth, time and weight in `f`. A repetitive texture matched one
-/// period off in some frames, or a flow that slid onto another surface, steps by whole pixels;
-/// the matcher's noise stays under the pixel bound, a smooth change of speed under the fraction.
-bool chain_has_outlier(const VelocityFit& f, const float* z, const double* t, const double* w,
-                       int slots, double fb, const SceneFlowParams& p) {
+/// p.chain_outlier_fraction of its own disparity. A repetitive texture matched one period off in
+/// some frames, or a flow that slid onto another surface, steps by whole pixels; the matcher's
+/// noise stays under the pixel bound, a smooth change of speed under the fraction.
+bool chain_has_outlier(const VelocityFit& f, const ChainSamples& s, int x, double fb,
+                       const SceneFlowParams& p) {
   if (f.n < 3) return false;  // two samples left make a line through both: nothing to test
-  for (int j = 0; j < slots; ++j) {
+  const float* z = s.depth(x);
+  const double* w = s.weight(x);
+  const double* t = s.times.data();
+  for (int j = 0; j < s.slots; ++j) {
     if (std::isnan(z[j])) continue;
     const double sw = f.sw - w[j], st = f.st - w[j] * t[j], stt = f.stt - w[j] * t[j] * t[j];
     const double sz = f.sp[2] - w[j] * z[j], stz = f.stp[2] - w[j] * t[j] * z[j];
@@ -380,6 +413,127 @@ void allocate_stereo_flow_outputs(cv::Size size, cv::Mat& danger, cv::Mat& ttc, 
   velocity.create(size, CV_32FC3);
 }
 
+namespace {
+
+/// label_stereo_flow_rows' inputs for one call: the gaps ascending by chain length (one per
+/// length: the chain is walked once per pixel), the pixel test and the sampling bounds.
+struct RowInputs {
+  const cv::Mat& disp_cur;
+  const cv::Mat& edges_cur;
+  const std::vector<const cv::Mat*>& flows;
+  std::vector<GapSource> gaps;
+  const core::Camera& cam;
+  const core::Envelope& env;
+  const SceneFlowParams& p;
+  PixelTest test;
+  float max_step;
+  double fb;
+
+  /// Whether the source `at` of gap g lies near a depth edge of its past disparity.
+  bool past_edge(const GapSource& g, cv::Point2f at) const {
+    if (p.edge_margin_px <= 0) return false;
+    const int x = std::clamp(cvRound(at.x), 0, disp_cur.cols - 1);
+    const int y = std::clamp(cvRound(at.y), 0, disp_cur.rows - 1);
+    if (g.edges) return g.edges->at<uint8_t>(y, x) != 0;
+    return near_depth_edge(*g.disparity, x, y, p.edge_margin_px,
+                           static_cast<float>(p.edge_step_px));
+  }
+};
+
+/// One row's outputs.
+struct RowOutputs {
+  uint8_t* danger;
+  float* ttc;
+  cv::Vec3f* velocity;
+  float* residuals;  ///< slots per pixel, or null
+};
+
+/// With fit_velocity: gap gi's sample of every live pixel's chain (now at q[x]) goes into its fit
+/// unless its past disparity is invalid, mixes a depth edge, or lies near one.
+void add_fit_samples(const RowInputs& in, size_t gi, const std::vector<int>& live,
+                     const std::vector<cv::Point2f>& q, const float* d_row,
+                     std::vector<VelocityFit>& fits, ChainSamples& samples) {
+  const GapSource& g = in.gaps[gi];
+  for (const int x : live) {
+    float d_prev;
+    if (!sample_disparity_bilinear(*g.disparity, q[x].x, q[x].y, d_prev, in.max_step) ||
+        !(d_prev > 0.0f) || in.past_edge(g, q[x]))
+      continue;
+    cv::Vec3d P = in.test.point(q[x].x, q[x].y, d_prev);
+    if (g.derotate) P = *g.derotate * P;
+    // Weight 1 / var(Z) relative to now's: Z's error grows as Z^2 = (f B / d)^2.
+    const double rel = static_cast<double>(d_prev) / d_row[x];
+    const double w = rel * rel * rel * rel;
+    fits[x].add(-g.span_s, P, w);
+    samples.add(x, gi, P[2], w);
+  }
+}
+
+/// Without fit_velocity: gap gi's verdict for every live pixel of row y (its chain now at q[x]).
+void apply_gap_verdicts(const RowInputs& in, size_t gi, int y, const std::vector<int>& live,
+                        const std::vector<cv::Point2f>& q, const float* d_row,
+                        const RowOutputs& out) {
+  const GapSource& g = in.gaps[gi];
+  const cv::Vec3f unknown(kNaN, kNaN, kNaN);
+  for (const int x : live) {
+    float d_prev;
+    if (!sample_disparity_bilinear(*g.disparity, q[x].x, q[x].y, d_prev, in.max_step)) continue;
+    const GapResult res = in.test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x],
+                                  d_prev, g.span_s, g.derotate);
+    if (!res.velocity_known) continue;
+    // A source near a past depth edge pairs the object now with the background before (or
+    // the reverse): neither its verdict nor its velocity can be trusted.
+    const bool at_edge = in.past_edge(g, q[x]);
+    const bool dangerous = res.dangerous && !at_edge;
+    const cv::Vec3f v = at_edge ? unknown : cv::Vec3f(res.velocity);
+    if (in.p.longest_gap_decides) {
+      // Gaps ascend: each known estimate replaces those of the shorter, noisier gaps.
+      out.danger[x] = dangerous ? 255 : 0;
+      out.ttc[x] = dangerous ? static_cast<float>(res.ttc) : kNaN;
+      out.velocity[x] = v;
+    } else if (dangerous) {
+      if (out.danger[x] == 0 || res.ttc < out.ttc[x]) {
+        out.ttc[x] = static_cast<float>(res.ttc);
+        out.velocity[x] = cv::Vec3f(res.velocity);
+      }
+      out.danger[x] = 255;
+    } else if (out.danger[x] == 0 && !at_edge) {
+      out.velocity[x] = v;  // larger gaps come later: least noisy wins
+    }
+  }
+}
+
+/// With fit_velocity: each candidate's fitted velocity, verdict and residuals, unless its chain
+/// has an outlier (then its velocity is unknown).
+void conclude_fits(const RowInputs& in, const std::vector<int>& candidates,
+                   const std::vector<VelocityFit>& fits, const ChainSamples& samples,
+                   const float* d_row, const RowOutputs& out) {
+  const int slots = samples.slots;
+  const bool outlier_test = in.p.chain_outlier_px > 0.0;
+  for (const int x : candidates) {
+    cv::Vec3d V;
+    float* r_px = out.residuals ? out.residuals + x * slots : nullptr;
+    const VelocityFit& f = fits[x];
+    if (!f.slope(V) || (outlier_test && chain_has_outlier(f, samples, x, in.fb, in.p))) {
+      if (r_px) std::fill_n(r_px, slots, kNaN);
+      continue;
+    }
+    const GapResult res = in.test.verdict(f.now, d_row[x], V, f.span_s);
+    out.danger[x] = res.dangerous ? 255 : 0;
+    out.ttc[x] = res.dangerous ? static_cast<float>(res.ttc) : kNaN;
+    out.velocity[x] = cv::Vec3f(res.velocity);
+    if (!r_px) continue;
+    // Z's distance from the fitted line at each sample: now, then the past frames' samples.
+    const double tb = f.st / f.sw, zb = f.sp[2] / f.sw;
+    const float* z = samples.depth(x);
+    for (int j = 0; j < slots; ++j)
+      r_px[j] = std::isnan(z[j]) ? kNaN
+                                 : static_cast<float>(z[j] - (zb + V[2] * (samples.times[j] - tb)));
+  }
+}
+
+}  // namespace
+
 void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
                             const std::vector<const cv::Mat*>& flows,
                             const std::vector<GapSource>& gap_sources, const core::Camera& cam,
@@ -390,8 +544,9 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
   check_same(disp_cur, danger, CV_8UC1, "the danger output");
   check_same(disp_cur, ttc, CV_32FC1, "the TTC output");
   check_same(disp_cur, velocity, CV_32FC3, "the velocity output");
-  // Gaps ascending by chain length, one per length: the chain is walked once per pixel.
-  std::vector<GapSource> gaps;
+  RowInputs in{disp_cur, edges_cur, flows, {}, cam, env, p, PixelTest(cam, env, p),
+               static_cast<float>(p.max_disparity_step_px), cam.focal_px * cam.baseline_m};
+  std::vector<GapSource>& gaps = in.gaps;
   for (const GapSource& g : gap_sources) {
     if (g.steps < 1 || g.steps > static_cast<int>(flows.size()) || !(g.span_s > 0.0)) continue;
     check_same(disp_cur, *g.disparity, CV_32FC1, "a past disparity");
@@ -412,20 +567,7 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
     check_same(disp_cur, *flows[static_cast<size_t>(j)], CV_32FC2, "a flow");
   const cv::Range r = rows == cv::Range::all() ? cv::Range(0, disp_cur.rows) : rows;
 
-  const cv::Vec3f unknown(kNaN, kNaN, kNaN);
-  const float max_step = static_cast<float>(p.max_disparity_step_px);
-  const PixelTest test(cam, env, p);
-  // The source q of a gap lies near a depth edge of its past disparity.
-  auto past_edge = [&](const GapSource& g, cv::Point2f at) {
-    if (p.edge_margin_px <= 0) return false;
-    const int x = std::clamp(cvRound(at.x), 0, disp_cur.cols - 1);
-    const int y = std::clamp(cvRound(at.y), 0, disp_cur.rows - 1);
-    if (g.edges) return g.edges->at<uint8_t>(y, x) != 0;
-    return near_depth_edge(*g.disparity, x, y, p.edge_margin_px,
-                           static_cast<float>(p.edge_step_px));
-  };
-
-  const float d_min = static_cast<float>(cam.focal_px * cam.baseline_m / p.z_max_m);
+  const float d_min = static_cast<float>(in.fb / p.z_max_m);
   // Nearer than chain_stride_z_m only a grid of pixels is followed (pooling gives the others
   // their surface's velocity). By absolute row and column, so tiles follow the same pixels.
   const ChainStrides strides(cam, p);
@@ -442,45 +584,34 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
   live.reserve(disp_cur.cols);
   candidates.reserve(disp_cur.cols);
   std::vector<VelocityFit> fits(p.fit_velocity ? disp_cur.cols : 0);
-  // Each followed pixel's depth and weight at each sample time of its fit (depth NaN: no
-  // sample), for the outlier test and the residuals; the sample times.
-  std::vector<float> depths(p.fit_velocity ? static_cast<size_t>(slots) * disp_cur.cols : 0);
-  std::vector<double> weights(depths.size()), times(static_cast<size_t>(slots), 0.0);
-  for (size_t j = 1; j < times.size(); ++j) times[j] = -gaps[j - 1].span_s;
-  const bool outlier_test = p.chain_outlier_px > 0.0;
-  const double fb = cam.focal_px * cam.baseline_m;
+  ChainSamples samples(gaps, p.fit_velocity ? disp_cur.cols : 0);
   for (int y = r.start; y < r.end; ++y) {
     const float* d_row = disp_cur.ptr<float>(y);
     const uint8_t* edge_row = edges_cur.ptr<uint8_t>(y);
-    uint8_t* danger_row = danger.ptr<uint8_t>(y);
-    float* ttc_row = ttc.ptr<float>(y);
-    cv::Vec3f* vel_row = velocity.ptr<cv::Vec3f>(y);
-    float* res_row = residuals ? residuals->ptr<float>(y) : nullptr;
-    if (res_row) std::fill(res_row, res_row + static_cast<size_t>(slots) * disp_cur.cols, kNaN);
+    const RowOutputs out{danger.ptr<uint8_t>(y), ttc.ptr<float>(y), velocity.ptr<cv::Vec3f>(y),
+                         residuals ? residuals->ptr<float>(y) : nullptr};
+    if (out.residuals)
+      std::fill(out.residuals, out.residuals + static_cast<size_t>(slots) * disp_cur.cols, kNaN);
     live.clear();
     const auto fy = static_cast<float>(y);
     for (int x = 0; x < disp_cur.cols; ++x) {
-      danger_row[x] = 0;
-      ttc_row[x] = kNaN;
-      vel_row[x] = unknown;
+      out.danger[x] = 0;
+      out.ttc[x] = kNaN;
+      out.velocity[x] = cv::Vec3f(kNaN, kNaN, kNaN);
       if (d_row[x] > 0.0f && d_row[x] >= d_min && edge_row[x] == 0 &&
           strides.followed(x, y, d_row[x]) && (!p.use_envelope_band || in_band(y, d_row[x]))) {
-        q[x] = cv::Point2f(static_cast<float>(x), static_cast<float>(y));
+        q[x] = cv::Point2f(static_cast<float>(x), fy);
         live.push_back(x);
         if (p.fit_velocity) {
-          fits[x].reset(test.point(static_cast<float>(x), fy, d_row[x]));
-          float* z = &depths[static_cast<size_t>(x) * slots];
-          std::fill(z, z + slots, kNaN);
-          z[0] = static_cast<float>(fits[x].now[2]);
-          weights[static_cast<size_t>(x) * slots] = 1.0;
+          fits[x].reset(in.test.point(static_cast<float>(x), fy, d_row[x]));
+          samples.start(x, fits[x].now[2]);
         }
       }
     }
     if (p.fit_velocity) candidates = live;
     int step = 0;
     for (size_t gi = 0; gi < gaps.size(); ++gi) {
-      const GapSource& g = gaps[gi];
-      for (; step < g.steps && !live.empty(); ++step) {
+      for (; step < gaps[gi].steps && !live.empty(); ++step) {
         const cv::Mat& flow = *flows[static_cast<size_t>(step)];
         size_t kept = 0;
         for (const int x : live) {
@@ -493,77 +624,12 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
         live.resize(kept);
       }
       if (live.empty()) break;
-      const cv::Mat& past = *g.disparity;
-      if (p.fit_velocity) {
-        for (const int x : live) {
-          float d_prev;
-          if (!sample_disparity_bilinear(past, q[x].x, q[x].y, d_prev, max_step) ||
-              !(d_prev > 0.0f) || past_edge(g, q[x]))
-            continue;
-          cv::Vec3d P = test.point(q[x].x, q[x].y, d_prev);
-          if (g.derotate) P = *g.derotate * P;
-          // Weight 1 / var(Z) relative to now's: Z's error grows as Z^2 = (f B / d)^2.
-          const double rel = static_cast<double>(d_prev) / d_row[x];
-          const double w = rel * rel * rel * rel;
-          fits[x].add(-g.span_s, P, w);
-          depths[static_cast<size_t>(x) * slots + gi + 1] = static_cast<float>(P[2]);
-          weights[static_cast<size_t>(x) * slots + gi + 1] = w;
-        }
-        continue;
-      }
-      for (const int x : live) {
-        float d_prev;
-        if (!sample_disparity_bilinear(past, q[x].x, q[x].y, d_prev, max_step)) continue;
-        const GapResult res = test(static_cast<float>(x), static_cast<float>(y), d_row[x], q[x],
-                                   d_prev, g.span_s, g.derotate);
-        if (!res.velocity_known) continue;
-        // A source near a past depth edge pairs the object now with the background before (or
-        // the reverse): neither its verdict nor its velocity can be trusted.
-        const bool at_edge = past_edge(g, q[x]);
-        const bool dangerous = res.dangerous && !at_edge;
-        const cv::Vec3f v = at_edge ? unknown : cv::Vec3f(res.velocity);
-        if (p.longest_gap_decides) {
-          // Gaps ascend: each known estimate replaces those of the shorter, noisier gaps.
-          danger_row[x] = dangerous ? 255 : 0;
-          ttc_row[x] = dangerous ? static_cast<float>(res.ttc) : kNaN;
-          vel_row[x] = v;
-        } else if (dangerous) {
-          if (danger_row[x] == 0 || res.ttc < ttc_row[x]) {
-            ttc_row[x] = static_cast<float>(res.ttc);
-            vel_row[x] = cv::Vec3f(res.velocity);
-          }
-          danger_row[x] = 255;
-        } else if (danger_row[x] == 0 && !at_edge) {
-          vel_row[x] = v;  // larger gaps come later: least noisy wins
-        }
-      }
+      if (p.fit_velocity)
+        add_fit_samples(in, gi, live, q, d_row, fits, samples);
+      else
+        apply_gap_verdicts(in, gi, y, live, q, d_row, out);
     }
-    if (!p.fit_velocity) continue;
-    for (const int x : candidates) {
-      cv::Vec3d V;
-      float* r_px = res_row ? res_row + x * slots : nullptr;
-      if (!fits[x].slope(V)) {
-        if (r_px) std::fill_n(r_px, slots, kNaN);
-        continue;
-      }
-      // Z's distance from the fitted line at each sample: now, then the past frames' samples.
-      const VelocityFit& f = fits[x];
-      const double tb = f.st / f.sw, zb = f.sp[2] / f.sw;
-      const float* z = &depths[static_cast<size_t>(x) * slots];
-      auto fitted = [&](int j) { return zb + V[2] * (times[static_cast<size_t>(j)] - tb); };
-      const double* w = &weights[static_cast<size_t>(x) * slots];
-      if (outlier_test && chain_has_outlier(f, z, times.data(), w, slots, fb, p)) {
-        if (r_px) std::fill_n(r_px, slots, kNaN);
-        continue;  // a mismatch on the chain: the velocity is unknown
-      }
-      const GapResult res = test.verdict(f.now, d_row[x], V, f.span_s);
-      danger_row[x] = res.dangerous ? 255 : 0;
-      ttc_row[x] = res.dangerous ? static_cast<float>(res.ttc) : kNaN;
-      vel_row[x] = cv::Vec3f(res.velocity);
-      if (r_px)
-        for (int j = 0; j < slots; ++j)
-          r_px[j] = std::isnan(z[j]) ? kNaN : static_cast<float>(z[j] - fitted(j));
-    }
+    if (p.fit_velocity) conclude_fits(in, candidates, fits, samples, d_row, out);
   }
 }
 
