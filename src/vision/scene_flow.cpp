@@ -419,11 +419,7 @@ namespace {
 /// length: the chain is walked once per pixel), the pixel test and the sampling bounds.
 struct RowInputs {
   const cv::Mat& disp_cur;
-  const cv::Mat& edges_cur;
-  const std::vector<const cv::Mat*>& flows;
   std::vector<GapSource> gaps;
-  const core::Camera& cam;
-  const core::Envelope& env;
   const SceneFlowParams& p;
   PixelTest test;
   float max_step;
@@ -544,7 +540,7 @@ void label_stereo_flow_rows(const cv::Mat& disp_cur, const cv::Mat& edges_cur,
   check_same(disp_cur, danger, CV_8UC1, "the danger output");
   check_same(disp_cur, ttc, CV_32FC1, "the TTC output");
   check_same(disp_cur, velocity, CV_32FC3, "the velocity output");
-  RowInputs in{disp_cur, edges_cur, flows, {}, cam, env, p, PixelTest(cam, env, p),
+  RowInputs in{disp_cur, {}, p, PixelTest(cam, env, p),
                static_cast<float>(p.max_disparity_step_px), cam.focal_px * cam.baseline_m};
   std::vector<GapSource>& gaps = in.gaps;
   for (const GapSource& g : gap_sources) {
