@@ -109,6 +109,17 @@ int scaled_area(int area_px, double area_ratio) {
   return std::max(kMinAreaFloorPx, static_cast<int>(std::lround(area_px * area_ratio)));
 }
 
+/// `block_px` (odd) for an image `width` px wide: the same angle as at kReferenceWidth, the odd
+/// size at or below block_px x width / kReferenceWidth, never smaller than block_px nor larger
+/// than kMaxDerivedBlock.
+int scaled_block(int block_px, int width) {
+  if (block_px >= kMaxDerivedBlock) return block_px;
+  int scaled = static_cast<int>(
+      std::lround(block_px * static_cast<double>(width) / kReferenceWidth));
+  if (scaled % 2 == 0) --scaled;
+  return std::clamp(scaled, block_px, kMaxDerivedBlock);
+}
+
 }  // namespace
 
 CameraFit depth_range(const DetectorParams& params, const Camera& camera) {
@@ -132,6 +143,7 @@ CameraFit adapt_to_camera(DetectorParams& params, const Camera& camera) {
                             (static_cast<double>(kReferenceWidth) * kReferenceHeight);
   params.signal.min_area_px = scaled_area(params.signal.min_area_px, area_ratio);
   params.signal.region_min_px = scaled_area(params.signal.region_min_px, area_ratio);
+  params.bm.block_size = scaled_block(params.bm.block_size, camera.width);
   // The margin covers the block's fattening of the foreground (half a block) and the flow's
   // bleeding over edges, which shrinks with the image; it never grows past the default.
   const int margin = static_cast<int>(

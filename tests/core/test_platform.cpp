@@ -142,5 +142,39 @@ TEST(AdaptToCamera, SizesScaleWithTheImageAndGapsKeepTheirSeconds) {
   EXPECT_TRUE(validate(r, small).empty());
 }
 
+TEST(AdaptToCamera, TheBlockKeepsItsAngleAboveTheReferenceWidth) {
+  const int block = DetectorParams{}.bm.block_size;
+  ASSERT_EQ(block, 11);
+  const auto block_at = [](int width, int height) {
+    Camera camera;
+    camera.width = width;
+    camera.height = height;
+    DetectorParams p;
+    adapt_to_camera(p, camera);
+    EXPECT_TRUE(validate(p, camera).empty()) << width << "x" << height;
+    return p.bm.block_size;
+  };
+  EXPECT_EQ(block_at(640, 480), 11);
+  EXPECT_EQ(block_at(752, 480), 13);   // 12.9
+  EXPECT_EQ(block_at(848, 480), 15);   // 14.6
+  EXPECT_EQ(block_at(1280, 720), 21);  // 22: the odd size below
+  EXPECT_EQ(block_at(1920, 1080), kMaxDerivedBlock);
+  EXPECT_EQ(block_at(320, 240), 11);  // narrower images keep it
+  EXPECT_EQ(block_at(122, 94), 11);
+  // The largest derived block fits the fast matcher at the largest prefilter cap.
+  Camera wide;
+  wide.width = 1920;
+  wide.height = 1080;
+  DetectorParams p;
+  adapt_to_camera(p, wide);
+  p.bm.prefilter_cap = 63;
+  EXPECT_TRUE(validate(p, wide).empty());
+  // A block set larger than the derived one stays.
+  DetectorParams q;
+  q.bm.block_size = 25;
+  adapt_to_camera(q, wide);
+  EXPECT_EQ(q.bm.block_size, 25);
+}
+
 }  // namespace
 }  // namespace sg::core

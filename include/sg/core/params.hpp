@@ -66,7 +66,7 @@ struct BmParams {
   MatchCost cost = MatchCost::kSad; ///< cost of the fast matcher (bm/sgbm ignore it)
   int min_disparity = 0;        ///< px
   int num_disparities = 64;     ///< px, positive multiple of 16
-  int block_size = 11;          ///< px, odd, 5..255
+  int block_size = 11;          ///< px, odd, 5..255 (at 640 px wide; core::adapt_to_camera)
   int prefilter_cap = 31;       ///< 1..63
   int texture_threshold = 10;   ///< >= 0; low-texture blocks become invalid
   int uniqueness_ratio = 15;    ///< percent, >= 0

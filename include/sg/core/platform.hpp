@@ -40,6 +40,9 @@ inline constexpr double kReferenceFps = 30.0;
 /// The largest disparity range derived from a camera, px: beyond it matching costs grow and the
 /// left image loses that many columns.
 inline constexpr int kMaxDerivedDisparities = 256;
+/// The largest matching block derived from a camera, px: it fits the fast matcher's 16-bit sums
+/// at prefilter caps up to 63 (DESIGN 2.1).
+inline constexpr int kMaxDerivedBlock = 21;
 
 /// What adapt_to_camera set, for the run's first line and its warnings.
 struct CameraFit {
@@ -58,6 +61,9 @@ struct CameraFit {
 ///    image width (with `warning` set);
 ///  * pixel areas (signal.min_area_px, signal.region_min_px) scale with the image area, and
 ///    lengths (scene_flow.edge_margin_px) with its width, from kReferenceWidth x kReferenceHeight;
+///  * bm.block_size grows with the width above kReferenceWidth, so that the block keeps its angle
+///    (the odd size at or below, up to kMaxDerivedBlock; 21 px at 1280 wide); narrower images
+///    keep it;
 ///  * frame counts keep their time at the camera's rate (written for kReferenceFps), at least one
 ///    frame each: the gaps (stereo.gaps, scene_flow.gaps; a 20-frame gap at 30 fps is 10 frames
 ///    at 15 fps) and the hysteresis (signal.on_k, on_n, off_m, severity_off_frames).
