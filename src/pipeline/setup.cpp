@@ -1,5 +1,7 @@
 #include "sg/pipeline/setup.hpp"
 
+#include <filesystem>
+
 #include "sg/core/error.hpp"
 #include "sg/core/platform.hpp"
 #include "sg/io/scaled_source.hpp"
@@ -67,7 +69,13 @@ OpenedInput open_input(const InputOptions& options_in, const std::string& config
 }
 
 std::string input_platform(const OpenedInput& input) {
-  return input.scenario ? input.scenario->scenario().platform : std::string();
+  if (input.scenario) return input.scenario->scenario().platform;
+  if (input.folder) {
+    // A folder that `simulate` wrote carries its scenario, whose platform made its ground truth.
+    const std::filesystem::path file = std::filesystem::path(input.name) / "scenario.yaml";
+    if (std::filesystem::is_regular_file(file)) return sim::load_scenario_file(file.string()).platform;
+  }
+  return {};
 }
 
 core::CameraFit camera_fit(const RunOptions& options, const core::Camera& camera) {

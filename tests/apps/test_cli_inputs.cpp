@@ -102,6 +102,29 @@ class Inputs : public ::testing::Test {
   fs::path dir_;
 };
 
+TEST_F(Inputs, AFolderThatSimulateWroteIsScoredForItsScenariosPlatform) {
+  // The car's contact plane lies 2.0 m ahead, the robot's 0.5 m: an obstacle 3.5 m away closing at
+  // 3 m/s is due at once for the car and not yet for the robot.
+  std::ofstream(dir_ / "car.yaml")
+      << "name: small-car\nframes: 12\nplatform: car\n"
+      << "camera: {width: 321, height: 241, focal_px: 250, cx: 160, cy: 120, fps: 25}\n"
+      << "obstacles:\n  - {id: 1, size_m: [1.0, 1.5, 0.5], position_m: [0, 0.45, 3.5], "
+         "velocity_mps: [0, 0, -3]}\n";
+  ASSERT_EQ(sg("simulate --scenario car.yaml --out fold").status, 0);
+  for (const char* run : {"--events own.jsonl", "--events car.jsonl --platform car",
+                          "--events robot.jsonl --platform robot"}) {
+    const Output r = sg(std::string("run --input fold --no-timing --quiet ") + run);
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  const std::string own = read_text(dir_ / "own.jsonl");
+  ASSERT_FALSE(own.empty());
+  EXPECT_EQ(own, read_text(dir_ / "car.jsonl"));
+  EXPECT_NE(own, read_text(dir_ / "robot.jsonl"));
+  // A scenario.yaml that does not load is a clear error, not the robot's figures.
+  std::ofstream(dir_ / "fold" / "scenario.yaml") << "platform: boat\n";
+  expect_user_error(sg("run --input fold --quiet"), "boat");
+}
+
 TEST_F(Inputs, TwoLosslessVideosGiveTheEventsOfTheFolder) {
   require_ffmpeg();
   make_folder();

@@ -40,7 +40,9 @@ struct OpenedInput {
 /// no input is given. Throws core::InputError for two inputs at once or a broken input.
 OpenedInput open_input(const InputOptions& options, const std::string& config = {});
 
-/// The platform a scenario input is made for ("" for a folder or a scenario without one).
+/// The platform a scenario input is made for: the scenario's, or for a stereo folder the one its
+/// scenario.yaml names (`simulate` writes it beside the images); "" without one. Throws
+/// core::InputError for a scenario.yaml that does not load.
 std::string input_platform(const OpenedInput& input);
 
 /// Detector choices (the CLI's --config, --mode, --num-disparities, --block-size, --gaps, --fps,
