@@ -113,11 +113,10 @@ int scaled_area(int area_px, double area_ratio) {
 /// size at or below block_px x width / kReferenceWidth, never smaller than block_px nor larger
 /// than kMaxDerivedBlock.
 int scaled_block(int block_px, int width) {
-  if (block_px >= kMaxDerivedBlock) return block_px;
   int scaled = static_cast<int>(
       std::lround(block_px * static_cast<double>(width) / kReferenceWidth));
   if (scaled % 2 == 0) --scaled;
-  return std::clamp(scaled, block_px, kMaxDerivedBlock);
+  return std::max(block_px, std::min(scaled, kMaxDerivedBlock));
 }
 
 }  // namespace
@@ -145,7 +144,8 @@ CameraFit adapt_to_camera(DetectorParams& params, const Camera& camera) {
   params.signal.region_min_px = scaled_area(params.signal.region_min_px, area_ratio);
   params.bm.block_size = scaled_block(params.bm.block_size, camera.width);
   // The margin covers the block's fattening of the foreground (half a block) and the flow's
-  // bleeding over edges, which shrinks with the image; it never grows past the default.
+  // bleeding over edges, which shrinks with the image; it never grows past the default, even
+  // where the grown block's half exceeds it (10 px at 1280 wide against a margin of 8).
   const int margin = static_cast<int>(
       std::lround(params.scene_flow.edge_margin_px * static_cast<double>(camera.width) /
                   kReferenceWidth));

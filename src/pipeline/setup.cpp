@@ -73,7 +73,8 @@ std::string input_platform(const OpenedInput& input) {
   if (input.folder) {
     // A folder that `simulate` wrote carries its scenario, whose platform made its ground truth.
     const std::filesystem::path file = std::filesystem::path(input.name) / "scenario.yaml";
-    if (std::filesystem::is_regular_file(file)) return sim::load_scenario_file(file.string()).platform;
+    if (std::filesystem::is_regular_file(file))
+      return sim::load_scenario_file(file.string()).platform;
   }
   return {};
 }
