@@ -194,7 +194,7 @@ par::TaskList make_tasks(FrameJob& job, const RunOptions& o) {
     tiled(frame.left.rows, o.tiles, [&](cv::Range rows) {
       vision::disparity_rows(frame, o.params, job.maps.disparity, rows);
     });
-    vision::disparity_finish(o.params, job.maps.disparity);
+    vision::disparity_finish(frame, o.params, job.maps.disparity);
     if (flow_mode) vision::depth_edges(o.params, job.maps.disparity, job.maps.edges);
     job.sm_ms = watch.elapsed_ms();
   });

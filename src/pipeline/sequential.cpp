@@ -24,7 +24,7 @@ core::Detection SequentialDetector::process(const core::StereoFrame& frame) {
   if (need.disparity) {
     vision::allocate_maps(frame.left.size(), false, maps.disparity, maps.flow);
     vision::disparity_rows(frame, params_, maps.disparity, cv::Range::all());
-    vision::disparity_finish(params_, maps.disparity);
+    vision::disparity_finish(frame, params_, maps.disparity);
     if (params_.mode == core::Mode::kStereoFlow) {
       vision::depth_edges(params_, maps.disparity, maps.edges);
     }

@@ -13,6 +13,12 @@ namespace sg::pipeline {
 
 StereoMatcherEntry parse_matcher_entry(const std::string& text, const core::BmParams& base) {
   StereoMatcherEntry e{text, base};
+  e.params.coarse_fill = false;  // the matcher alone, unless the label asks for the filled map
+  if (text == "fast-filled") {
+    e.params.matcher = core::Matcher::kFast;
+    e.params.coarse_fill = true;
+    return e;
+  }
   if (text == "fast-sad" || text == "fast-census") {
     e.params.matcher = core::Matcher::kFast;
     e.params.cost = text == "fast-sad" ? core::MatchCost::kSad : core::MatchCost::kCensus;
@@ -23,7 +29,7 @@ StereoMatcherEntry parse_matcher_entry(const std::string& text, const core::BmPa
   } catch (const core::InputError&) {
     throw core::InputError("matchers=" + text +
                            ": each must be bm, sgbm, fast, fast-sad, "
-                           "fast-census or longseq");
+                           "fast-census, fast-filled or longseq");
   }
   return e;
 }
@@ -59,7 +65,7 @@ std::vector<StereoEvalRow> evaluate_stereo(
       for (int run = 0; run < 3; ++run) {
         const auto t0 = std::chrono::steady_clock::now();
         vision::disparity_rows(frame, params, disp, cv::Range::all());
-        vision::disparity_finish(params, disp);
+        vision::disparity_finish(frame, params, disp);
         const auto t1 = std::chrono::steady_clock::now();
         const double ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
         best_ms = run == 0 ? ms : std::min(best_ms, ms);

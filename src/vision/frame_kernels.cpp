@@ -3,6 +3,7 @@
 #include <string>
 
 #include "sg/core/error.hpp"
+#include "sg/vision/coarse_fill.hpp"
 #include "sg/vision/flow.hpp"
 #include "sg/vision/left_band.hpp"
 #include "sg/vision/longseq.hpp"
@@ -19,6 +20,18 @@ void check_frame(const core::StereoFrame& frame) {
                            ": left and right must be 8-bit gray images of the same size");
   }
 }
+
+namespace {
+
+/// The block matcher whose holes the half-size pair fills: bm and fast (sgbm's maps are dense,
+/// longseq is a different method), else nullptr.
+RowMatcher hole_filled_matcher(core::Matcher matcher) {
+  if (matcher == core::Matcher::kBm) return match_bm_rows;
+  if (matcher == core::Matcher::kFast) return match_fast_rows;
+  return nullptr;
+}
+
+}  // namespace
 
 void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& params,
                     cv::Mat& disp, cv::Range rows) {
@@ -48,8 +61,13 @@ void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& 
   if (params.bm.left_band) match_left_band_rows(match, frame.left, frame.right, params.bm, disp, rows);
 }
 
-void disparity_finish(const core::DetectorParams& params, cv::Mat& disp) {
+void disparity_finish(const core::StereoFrame& frame, const core::DetectorParams& params,
+                      cv::Mat& disp) {
   filter_speckles(disp, params.bm);
+  const RowMatcher match = hole_filled_matcher(params.bm.matcher);
+  if (params.bm.coarse_fill && match) {
+    fill_from_half_size(frame.left, frame.right, params.bm, match, disp);
+  }
 }
 
 void flow_rows(const cv::Mat& current, const cv::Mat& previous,

@@ -387,12 +387,13 @@ TEST(FrameKernels, DisparityMatchesBmAndMismatchedFramesAreRejected) {
   f.left = pair.left;
   f.right = pair.right;
   core::DetectorParams params;
-  params.bm.left_band = false;  // StereoBM leaves the band unmatched
+  params.bm.left_band = false;     // StereoBM leaves the band unmatched
+  params.bm.coarse_fill = false;   // and its holes
   cv::Mat disp, flow;
   check_frame(f);
   allocate_maps(f.left.size(), /*with_flow=*/false, disp, flow);
   disparity_rows(f, params, disp, cv::Range::all());
-  disparity_finish(params, disp);
+  disparity_finish(f, params, disp);
   ASSERT_EQ(disp.size(), pair.left.size());
   EXPECT_NEAR(disp.at<float>(48, 150), 9.0f, 0.25f);
   cv::Mat whole;

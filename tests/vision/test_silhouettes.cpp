@@ -20,7 +20,7 @@ double pole_centre_error(const sim::RenderedFrame& f, const core::DetectorParams
   cv::Mat disp, flow;
   allocate_maps(f.frame.left.size(), false, disp, flow);
   disparity_rows(f.frame, p, disp, cv::Range::all());
-  disparity_finish(p, disp);
+  disparity_finish(f.frame, p, disp);
   std::vector<double> errors;
   for (int y = 0; y < disp.rows; ++y) {
     int a = -1, b = -1;

@@ -82,6 +82,11 @@ struct BmParams {
   /// them unmatched: with a wide baseline or a near contact that is a third to half of the image
   /// (docs/decisions/left-band.md).
   bool left_band = true;
+  /// Fill the holes of a bm or fast map from the half-size pair (vision/coarse_fill.hpp): a
+  /// surface with too little texture for the sensor's noise keeps only its outline at full size
+  /// and is matched at half size. Only holes more than half a block from a matched pixel, and
+  /// only images at least 320 px wide. Why off for now: docs/decisions/coarse-fill.md.
+  bool coarse_fill = false;
   // LongSeq (matcher longseq): its window is one row of block_size pixels (<= 63), its disparities
   // 0 .. num_disparities - 1 (min_disparity 0).
   double longseq_cost_max = 6.0;  ///< a good match: mean absolute difference <= this, grey levels

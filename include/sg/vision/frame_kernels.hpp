@@ -18,8 +18,11 @@ void check_frame(const core::StereoFrame& frame);
 /// (allocate_maps). Tiles stitched are bit-identical to one call over all rows.
 void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& params,
                     cv::Mat& disp, cv::Range rows);
-/// SM finishing step over the whole map, after all tiles: the speckle filter.
-void disparity_finish(const core::DetectorParams& params, cv::Mat& disp);
+/// SM finishing step over the whole map, after all tiles: the speckle filter, then, with
+/// params.bm.coarse_fill and a row matcher (bm, fast), the holes filled from the half-size pair
+/// (vision/coarse_fill.hpp).
+void disparity_finish(const core::StereoFrame& frame, const core::DetectorParams& params,
+                      cv::Mat& disp);
 
 /// OF on output rows `rows`: backward flow from `current` to `previous` (left images). flow must
 /// be allocated as CV_32FC2 of the frame size. With tiles the result differs near the cuts within
