@@ -23,11 +23,18 @@ void check_frame(const core::StereoFrame& frame) {
 
 namespace {
 
-/// The block matcher whose holes the half-size pair fills: bm and fast (sgbm's maps are dense,
-/// longseq is a different method), else nullptr.
-RowMatcher hole_filled_matcher(core::Matcher matcher) {
-  if (matcher == core::Matcher::kBm) return match_bm_rows;
-  if (matcher == core::Matcher::kFast) return match_fast_rows;
+/// The row matcher of a matcher setting; nullptr for longseq, which has its own parameters.
+RowMatcher row_matcher(core::Matcher matcher) {
+  switch (matcher) {
+    case core::Matcher::kBm:
+      return match_bm_rows;
+    case core::Matcher::kSgbm:
+      return match_sgbm_rows;
+    case core::Matcher::kFast:
+      return match_fast_rows;
+    case core::Matcher::kLongSeq:
+      return nullptr;
+  }
   return nullptr;
 }
 
@@ -35,27 +42,16 @@ RowMatcher hole_filled_matcher(core::Matcher matcher) {
 
 void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& params,
                     cv::Mat& disp, cv::Range rows) {
-  RowMatcher match = nullptr;
-  switch (params.bm.matcher) {
-    case core::Matcher::kBm:
-      match = match_bm_rows;
-      break;
-    case core::Matcher::kSgbm:
-      match = match_sgbm_rows;
-      break;
-    case core::Matcher::kFast:
-      match = match_fast_rows;
-      break;
-    case core::Matcher::kLongSeq: {
-      LongSeqParams p;
-      p.num_disparities = params.bm.num_disparities;
-      p.window_px = params.bm.block_size;
-      p.cost_max = params.bm.longseq_cost_max;
-      p.best_max = params.bm.longseq_best_max;
-      p.both_ways = params.bm.longseq_both_ways;
-      longseq_disparity_rows(frame.left, frame.right, p, disp, rows);
-      return;
-    }
+  const RowMatcher match = row_matcher(params.bm.matcher);
+  if (!match) {  // longseq
+    LongSeqParams p;
+    p.num_disparities = params.bm.num_disparities;
+    p.window_px = params.bm.block_size;
+    p.cost_max = params.bm.longseq_cost_max;
+    p.best_max = params.bm.longseq_best_max;
+    p.both_ways = params.bm.longseq_both_ways;
+    longseq_disparity_rows(frame.left, frame.right, p, disp, rows);
+    return;
   }
   match(frame.left, frame.right, params.bm, disp, rows);
   if (params.bm.left_band) match_left_band_rows(match, frame.left, frame.right, params.bm, disp, rows);
@@ -64,9 +60,11 @@ void disparity_rows(const core::StereoFrame& frame, const core::DetectorParams& 
 void disparity_finish(const core::StereoFrame& frame, const core::DetectorParams& params,
                       cv::Mat& disp) {
   filter_speckles(disp, params.bm);
-  const RowMatcher match = hole_filled_matcher(params.bm.matcher);
-  if (params.bm.coarse_fill && match) {
-    fill_from_half_size(frame.left, frame.right, params.bm, match, disp);
+  // The block matchers' holes only: sgbm's maps are dense, longseq is a different method.
+  const bool block_matcher =
+      params.bm.matcher == core::Matcher::kBm || params.bm.matcher == core::Matcher::kFast;
+  if (params.bm.coarse_fill && block_matcher) {
+    fill_from_half_size(frame.left, frame.right, params.bm, row_matcher(params.bm.matcher), disp);
   }
 }
 

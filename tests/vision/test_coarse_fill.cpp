@@ -85,7 +85,8 @@ TEST(CoarseFill, MatchesAFaintNoisySurfaceThatTheFullSizeMatcherRejects) {
   EXPECT_GT(after, before + 0.2);
   cv::Mat error;
   cv::absdiff(disp(inside), 12.0f, error);
-  const double within_1px = cv::countNonZero((error <= 1.0f) & valid) / double(cv::countNonZero(valid));
+  const double within_1px =
+      cv::countNonZero((error <= 1.0f) & valid) / double(cv::countNonZero(valid));
   EXPECT_GT(within_1px, 0.85);
 }
 
