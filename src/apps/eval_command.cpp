@@ -37,7 +37,7 @@ struct EvalArgs {
   // --stereo: stereo accuracy against GT disparity.
   bool stereo = false;
   double gt_scale = 0;
-  std::string matchers = "bm,sgbm,fast,fast-filled,fast-census";
+  std::string matchers = "bm,sgbm,fast,fast-periodic,fast-filled,fast-census";
   int drop_every = 0;  ///< drop every n-th frame (5 = 20 %), 0 = none
   // --truth: a recording against a truth log; --baseline-method: a baseline instead.
   std::string truth, distance_column, baseline;
@@ -257,8 +257,9 @@ void add_eval_command(CLI::App& app) {
                   "from the folder's datasets.xml)");
   cmd->add_option("--matchers", args->matchers,
                   "with --stereo: bm, sgbm, fast, fast-sad, fast-census, fast-filled (fast with "
-                  "its holes filled at half size), longseq, comma-separated (default "
-                  "bm,sgbm,fast,fast-filled,fast-census)");
+                  "its holes filled at half size), fast-periodic (fast without its matches on "
+                  "repeating texture), longseq, comma-separated (default "
+                  "bm,sgbm,fast,fast-periodic,fast-filled,fast-census)");
   cmd->add_option("--flow-methods", args->flow_methods,
                   "with --flow: dis-ultrafast, dis-fast, dis-medium, farneback or all (default)");
   auto* suite_option = cmd->add_option(

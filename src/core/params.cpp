@@ -101,6 +101,8 @@ std::vector<std::string> validate(const BmParams& p) {
   c.require(p.speckle_window >= 0, "speckle_window", p.speckle_window, "must be >= 0");
   c.require(p.speckle_range >= 0, "speckle_range", p.speckle_range, "must be >= 0");
   c.require(p.lr_max_diff >= -1, "lr_max_diff", p.lr_max_diff, "must be -1 (off) or >= 0");
+  c.require(std::isfinite(p.periodic_ratio) && p.periodic_ratio >= 0 && p.periodic_ratio < 1,
+            "periodic_ratio", p.periodic_ratio, "must be in [0, 1) (0: off)");
   if (p.matcher == Matcher::kLongSeq) {
     c.require(p.block_size <= 63, "block_size", p.block_size,
               "must be <= 63 with matcher longseq (its one-row window)");

@@ -146,6 +146,7 @@ void apply_config_file(const std::filesystem::path& path, core::DetectorParams& 
         .field("lr_max_diff", p.bm.lr_max_diff)
         .field("left_band", p.bm.left_band)
         .field("coarse_fill", p.bm.coarse_fill)
+        .field("periodic_ratio", p.bm.periodic_ratio)
         .field("longseq_cost_max", p.bm.longseq_cost_max)
         .field("longseq_best_max", p.bm.longseq_best_max)
         .field("longseq_both_ways", p.bm.longseq_both_ways)

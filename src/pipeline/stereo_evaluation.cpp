@@ -13,7 +13,15 @@ namespace sg::pipeline {
 
 StereoMatcherEntry parse_matcher_entry(const std::string& text, const core::BmParams& base) {
   StereoMatcherEntry e{text, base};
-  e.params.coarse_fill = false;  // the matcher alone, unless the label asks for the filled map
+  // The matcher alone, unless the label asks for the filled map or the repeats dropped.
+  e.params.coarse_fill = false;
+  e.params.periodic_ratio = 0.0;
+  if (text == "fast-periodic") {
+    e.params.matcher = core::Matcher::kFast;
+    e.params.periodic_ratio =
+        base.periodic_ratio > 0 ? base.periodic_ratio : core::BmParams{}.periodic_ratio;
+    return e;
+  }
   if (text == "fast-filled") {
     e.params.matcher = core::Matcher::kFast;
     e.params.coarse_fill = true;
@@ -29,7 +37,7 @@ StereoMatcherEntry parse_matcher_entry(const std::string& text, const core::BmPa
   } catch (const core::InputError&) {
     throw core::InputError("matchers=" + text +
                            ": each must be bm, sgbm, fast, fast-sad, "
-                           "fast-census, fast-filled or longseq");
+                           "fast-census, fast-filled, fast-periodic or longseq");
   }
   return e;
 }

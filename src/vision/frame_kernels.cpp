@@ -4,6 +4,7 @@
 
 #include "sg/core/error.hpp"
 #include "sg/vision/coarse_fill.hpp"
+#include "sg/vision/periodic.hpp"
 #include "sg/vision/flow.hpp"
 #include "sg/vision/left_band.hpp"
 #include "sg/vision/longseq.hpp"
@@ -63,8 +64,15 @@ void disparity_finish(const core::StereoFrame& frame, const core::DetectorParams
   // The block matchers' holes only: sgbm's maps are dense, longseq is a different method.
   const bool block_matcher =
       params.bm.matcher == core::Matcher::kBm || params.bm.matcher == core::Matcher::kFast;
+  // Repeats fool every whole-pixel matcher; longseq stays the method the thesis describes.
+  cv::Mat periodic;
+  if (params.bm.periodic_ratio > 0 && params.bm.matcher != core::Matcher::kLongSeq) {
+    periodic = periodic_mask(frame.left, params.bm);
+    disp.setTo(-1.0f, periodic);
+  }
   if (params.bm.coarse_fill && block_matcher) {
     fill_from_half_size(frame.left, frame.right, params.bm, row_matcher(params.bm.matcher), disp);
+    if (!periodic.empty()) disp.setTo(-1.0f, periodic);  // the half-size pair repeats as well
   }
 }
 

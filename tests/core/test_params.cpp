@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 
 #include "sg/core/error.hpp"
@@ -22,6 +23,17 @@ TEST(Params, EvenBlockSizeIsRejected) {
   DetectorParams p;
   p.bm.block_size = 10;
   EXPECT_TRUE(mentions(validate(p, Camera{}), "stereo.block_size=10"));
+}
+
+TEST(Params, PeriodicRatioIsAShareBelowOne) {
+  for (double bad : {-0.1, 1.0, 2.0, std::nan("")}) {
+    DetectorParams p;
+    p.bm.periodic_ratio = bad;
+    EXPECT_TRUE(mentions(validate(p, Camera{}), "stereo.periodic_ratio=")) << bad;
+  }
+  DetectorParams off;
+  off.bm.periodic_ratio = 0.0;
+  EXPECT_TRUE(validate(off, Camera{}).empty());
 }
 
 TEST(Params, LongSeqMatcherRulesNameTheirFields) {

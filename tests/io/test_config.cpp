@@ -21,7 +21,8 @@ TEST(Config, SetsOnlyTheGivenFields) {
   ScratchDir dir;
   const auto path = write_file(dir,
                                "mode: stereo-flow\nfps: 15\n"
-                               "stereo: {num_disparities: 128, block_size: 9, coarse_fill: true}\n"
+                               "stereo: {num_disparities: 128, block_size: 9, coarse_fill: true, "
+                               "periodic_ratio: 0.3}\n"
                                "label: {gaps: [1, 3], max_growth: 3.0}\n"
                                "envelope: {half_width_m: 0.8}\n"
                                "signal: {min_area_px: 300, on_k: 1}\n");
@@ -33,6 +34,7 @@ TEST(Config, SetsOnlyTheGivenFields) {
   EXPECT_EQ(p.bm.num_disparities, 128);
   EXPECT_EQ(p.bm.block_size, 9);
   EXPECT_TRUE(p.bm.coarse_fill);
+  EXPECT_DOUBLE_EQ(p.bm.periodic_ratio, 0.3);
   EXPECT_EQ(p.stereo.gaps, (std::vector<int>{1, 3}));
   EXPECT_DOUBLE_EQ(p.stereo.max_growth, 3.0);
   EXPECT_DOUBLE_EQ(p.envelope.half_width_m, 0.8);

@@ -14,6 +14,7 @@
 #include "sg/pipeline/dropping_source.hpp"
 #include "sg/pipeline/plain_loop.hpp"
 #include "sg/pipeline/runner.hpp"
+#include "sg/pipeline/stereo_evaluation.hpp"
 #include "sg/sim/renderer.hpp"
 
 namespace sg::pipeline {
@@ -199,6 +200,7 @@ TEST_P(EveryConfiguration, PlainLoopGivesThePipelineDetections) {
     options.params.bm.lr_max_diff = -1;
     options.params.bm.left_band = false;  // the loop is StereoBM alone
     options.params.bm.coarse_fill = false;
+    options.params.bm.periodic_ratio = 0.0;  // nor drops the matches on repeating texture
     const std::vector<std::string> expected = detections(*clip, options);
     PlainLoop loop(options.params, clip->camera);
     std::vector<std::string> got;
@@ -206,6 +208,25 @@ TEST_P(EveryConfiguration, PlainLoopGivesThePipelineDetections) {
       got.push_back(io::detection_to_json(loop.process(f), /*timing=*/false).dump());
     EXPECT_EQ(got, expected);
   }
+}
+
+// eval --stereo's rows: each matcher alone, unless its label names the fill or the periodic check.
+TEST(Pipeline, StereoEvaluationRowsAreTheMatchersAloneUnlessTheLabelSaysOtherwise) {
+  core::BmParams base;
+  base.coarse_fill = true;
+  for (const char* label : {"bm", "sgbm", "fast", "fast-census"}) {
+    const StereoMatcherEntry e = parse_matcher_entry(label, base);
+    EXPECT_FALSE(e.params.coarse_fill) << label;
+    EXPECT_EQ(e.params.periodic_ratio, 0.0) << label;
+  }
+  EXPECT_TRUE(parse_matcher_entry("fast-filled", base).params.coarse_fill);
+  EXPECT_EQ(parse_matcher_entry("fast-periodic", base).params.periodic_ratio,
+            core::BmParams{}.periodic_ratio);
+  base.periodic_ratio = 0.0;  // --config turned it off: the row still shows the check
+  EXPECT_GT(parse_matcher_entry("fast-periodic", base).params.periodic_ratio, 0.0);
+  base.periodic_ratio = 0.45;
+  EXPECT_EQ(parse_matcher_entry("fast-periodic", base).params.periodic_ratio, 0.45);
+  EXPECT_THROW(parse_matcher_entry("fast-striped", base), core::InputError);
 }
 
 TEST(Pipeline, HeadOnClipFiresAndCrossingClipIsAnApproachOnlyInStereoMode) {

@@ -87,6 +87,11 @@ struct BmParams {
   /// and is matched at half size. Only holes more than half a block from a matched pixel, and
   /// only images at least 320 px wide. Why off for now: docs/decisions/coarse-fill.md.
   bool coarse_fill = false;
+  /// Drop matches whose block repeats along its row within the disparity range
+  /// (vision/periodic.hpp): shifted by a whole period the block matches itself better than this
+  /// share of its cost shifted by one pixel, about what the true match loses to a sub-pixel
+  /// offset. [0, 1); 0 disables. Why 0.3: docs/decisions/periodic-texture.md.
+  double periodic_ratio = 0.3;
   // LongSeq (matcher longseq): its window is one row of block_size pixels (<= 63), its disparities
   // 0 .. num_disparities - 1 (min_disparity 0).
   double longseq_cost_max = 6.0;  ///< a good match: mean absolute difference <= this, grey levels

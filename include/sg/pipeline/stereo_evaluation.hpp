@@ -18,9 +18,10 @@ struct StereoMatcherEntry {
 };
 
 /// Parses "bm", "sgbm", "fast", "fast-sad", "fast-census", "longseq" (each the matcher alone,
-/// without the half-size fill) or "fast-filled" (fast with its holes filled from the half-size
-/// pair, the detector's map) into an entry built on `base` (range, block size, thresholds);
-/// throws core::InputError otherwise.
+/// without the half-size fill or the periodic check), "fast-filled" (fast with its holes filled
+/// from the half-size pair) or "fast-periodic" (fast with the matches on repeating texture
+/// dropped, vision/periodic.hpp) into an entry built on `base` (range, block size,
+/// thresholds); throws core::InputError otherwise.
 StereoMatcherEntry parse_matcher_entry(const std::string& text, const core::BmParams& base);
 
 struct StereoEvalRow {
