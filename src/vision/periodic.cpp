@@ -85,7 +85,9 @@ void shift_cost(const cv::Mat& pre, int s, int block_cells, int cap,
 
 cv::Mat periodic_mask(const cv::Mat& left, const core::BmParams& p) {
   CV_Assert(left.type() == CV_8UC1);
-  cv::Mat mask = cv::Mat::zeros(left.size(), CV_8U);
+  // Not Mat::zeros: its MatExpr goes through OpenCV state that TSan, without OpenCV built for it,
+  // reports as a race between two farm workers.
+  cv::Mat mask(left.size(), CV_8U, cv::Scalar(0));
   const int max_shift = std::min(p.num_disparities, left.cols / 2);
   if (p.periodic_ratio <= 0.0 || max_shift <= 2 || left.rows < kCell) return mask;
   const cv::Mat pre = prefiltered(left, p.prefilter_cap);
