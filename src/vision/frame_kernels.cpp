@@ -4,10 +4,10 @@
 
 #include "sg/core/error.hpp"
 #include "sg/vision/coarse_fill.hpp"
-#include "sg/vision/periodic.hpp"
 #include "sg/vision/flow.hpp"
 #include "sg/vision/left_band.hpp"
 #include "sg/vision/longseq.hpp"
+#include "sg/vision/periodic.hpp"
 #include "sg/vision/stereo_bm.hpp"
 #include "sg/vision/stereo_fast.hpp"
 #include "sg/vision/stereo_sgbm.hpp"
