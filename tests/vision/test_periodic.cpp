@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+
+#include <hwy/targets.h>
 
 #include <opencv2/core.hpp>
 
@@ -127,6 +130,47 @@ TEST(PeriodicTexture, DropsOnlyTheRepeatingPartAndNothingWhenOff) {
   EXPECT_GT(marked_share(dropped, cv::Rect(size.width / 2 + 80, 8, size.width / 2 - 88,
                                            size.height - 16)),
             0.95);
+}
+
+// The kernel (every SIMD target this machine runs and this build compiled) equals the scalar
+// reference pixel for pixel: over image widths that are no multiple of a cell or a vector, blocks
+// of one to nine cells, ranges beyond half the width, both caps and two ratios, on a picture
+// that is half stripes and half noise so that both verdicts occur.
+TEST(PeriodicTexture, KernelEqualsTheScalarReferenceOnEveryTarget) {
+  int checked = 0;
+  for (const cv::Size size : {cv::Size(317, 123), cv::Size(640, 96)}) {
+    cv::Mat left = test::texture(size, 21, 1.5);
+    const int half = size.width / 2;
+    stripes({size.width - half, size.height}, 7.3, 0.0, 2.0, 5)
+        .copyTo(left(cv::Rect(half, 0, size.width - half, size.height)));
+    for (const int block : {5, 11, 21, 35})
+      for (const int range : {16, 64, 336})
+        for (const int cap : {31, 63})
+          for (const double ratio : {0.3, 0.6}) {
+            core::BmParams p;
+            p.block_size = block;
+            p.num_disparities = range;
+            p.prefilter_cap = cap;
+            p.periodic_ratio = ratio;
+            const cv::Mat expected = periodic_mask_reference(left, p);
+            const std::string what = std::to_string(size.width) + " px, block " +
+                                     std::to_string(block) + ", range " + std::to_string(range) +
+                                     ", cap " + std::to_string(cap) + ", ratio " +
+                                     std::to_string(ratio);
+            const int marked = cv::countNonZero(expected);
+            EXPECT_GT(marked, 0) << what;
+            EXPECT_LT(marked, size.area()) << what;
+            for (const int64_t target : hwy::SupportedAndGeneratedTargets()) {
+              hwy::SetSupportedTargetsForTest(target);
+              const cv::Mat mask = periodic_mask(left, p);
+              EXPECT_EQ(cv::countNonZero(mask != expected), 0)
+                  << what << ", target " << hwy::TargetName(target);
+              ++checked;
+            }
+            hwy::SetSupportedTargetsForTest(0);
+          }
+  }
+  EXPECT_GE(checked, 2 * 4 * 3 * 2 * 2);
 }
 
 }  // namespace

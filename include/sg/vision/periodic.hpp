@@ -24,4 +24,8 @@ namespace sg::vision {
 /// marked pixels' matches.
 cv::Mat periodic_mask(const cv::Mat& left, const core::BmParams& p);
 
+/// periodic_mask's scalar reference, pixel by pixel and cell by cell: the same mask, slower
+/// (tests compare the two).
+cv::Mat periodic_mask_reference(const cv::Mat& left, const core::BmParams& p);
+
 }  // namespace sg::vision
