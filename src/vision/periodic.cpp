@@ -67,17 +67,18 @@ void CellSums(const std::uint8_t* diff, int cells, std::int32_t* out) {
   }
 }
 
-/// acc[x] += add[x] - sub[x] for x < n (sub may be null).
+/// acc[x] += add[x] - sub[x] for x < n (either may be null: nothing added or taken).
 void AddSubRow(std::int32_t* acc, const std::int32_t* add, const std::int32_t* sub, int n) {
   const hn::ScalableTag<std::int32_t> d;
   const int lanes = static_cast<int>(hn::Lanes(d));
   int x = 0;
   for (; x + lanes <= n; x += lanes) {
-    auto v = hn::Add(hn::LoadU(d, acc + x), hn::LoadU(d, add + x));
+    auto v = hn::LoadU(d, acc + x);
+    if (add) v = hn::Add(v, hn::LoadU(d, add + x));
     if (sub) v = hn::Sub(v, hn::LoadU(d, sub + x));
     hn::StoreU(v, d, acc + x);
   }
-  for (; x < n; ++x) acc[x] += add[x] - (sub ? sub[x] : 0);
+  for (; x < n; ++x) acc[x] += (add ? add[x] : 0) - (sub ? sub[x] : 0);
 }
 
 /// out[x] = padded[x] + ... + padded[x + width - 1] for x < n; with `min`, out[x] takes the
@@ -218,8 +219,9 @@ class FastShiftCost {
     const int width = grid.pre.cols, half = grid.half, cols = grid.cols;
     diff_.resize(static_cast<size_t>(width));
     cells_.create(grid.rows, cols, CV_32S);
+    // x < s has no x - s; RowPairDiffs writes only x >= s, so this holds for every cell row
+    std::fill(diff_.begin(), diff_.begin() + s, static_cast<uint8_t>(no_partner_cost(grid)));
     for (int cy = 0; cy < grid.rows; ++cy) {
-      std::fill(diff_.begin(), diff_.begin() + s, static_cast<uint8_t>(no_partner_cost(grid)));
       HWY_DYNAMIC_DISPATCH(periodic_detail::RowPairDiffs)
       (grid.pre.ptr<uint8_t>(cy * kCell), grid.pre.ptr<uint8_t>(cy * kCell + kRowStep), width, s,
        diff_.data());
@@ -233,7 +235,7 @@ class FastShiftCost {
     for (int y = 0; y < grid.rows; ++y) {
       const int enter = y + half, leave = y - half - 1;
       HWY_DYNAMIC_DISPATCH(periodic_detail::AddSubRow)
-      (down, enter < grid.rows ? cells_.ptr<int32_t>(enter) : zeros(cols),
+      (down, enter < grid.rows ? cells_.ptr<int32_t>(enter) : nullptr,
        leave >= 0 ? cells_.ptr<int32_t>(leave) : nullptr, cols);
       HWY_DYNAMIC_DISPATCH(periodic_detail::WindowRow)
       (padded_.data(), cols, 2 * half + 1, min, cost.ptr<int32_t>(y));
@@ -241,12 +243,8 @@ class FastShiftCost {
   }
 
  private:
-  const int32_t* zeros(int n) {
-    zeros_.assign(static_cast<size_t>(n), 0);
-    return zeros_.data();
-  }
   std::vector<uint8_t> diff_;
-  std::vector<int32_t> padded_, zeros_;
+  std::vector<int32_t> padded_;
   cv::Mat cells_;
 };
 
