@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sg/core/error.hpp"
+#include "sg/sim/motion_blur.hpp"
 #include "sg/sim/texture.hpp"
 
 namespace sg::sim {
@@ -130,6 +131,7 @@ Hit cast(const Scene& sc, const cv::Vec3d& o, const cv::Vec3d& dir) {
       hit.axis = 2;
     }
   }
+  if (sc.boxes.empty()) return hit;
   const double inv[3] = {1.0 / safe_component(dir[0]), 1.0 / safe_component(dir[1]),
                          1.0 / safe_component(dir[2])};
   for (std::size_t i = 0; i < sc.boxes.size(); ++i) {
@@ -162,18 +164,20 @@ Hit cast(const Scene& sc, const cv::Vec3d& o, const cv::Vec3d& dir) {
   return hit;
 }
 
-/// Size in texture units of the pixel footprint on a face with (world) normal `axis`, using ray
+/// Size in texture units of the pixel footprint on a face with (world) normal `axis`, whose
+/// texture runs along u_axis (1 unit a metre) and v_axis (v_scale m a unit), using ray
 /// differentials of the direction dir = R (dx, dy, 1) at depth `depth`.
 double footprint(const Scene& sc, int axis, double depth, const cv::Vec3d& dir, int u_axis,
-                 int v_axis, double u_scale, double v_scale) {
-  // d dir / d dx and d dir / d dy, moved along the ray onto the face's plane.
-  cv::Vec3d ddx(sc.rot(0, 0), sc.rot(1, 0), sc.rot(2, 0));
-  cv::Vec3d ddy(sc.rot(0, 1), sc.rot(1, 1), sc.rot(2, 1));
+                 int v_axis, double v_scale) {
+  // d dir / d dx and d dir / d dy (R's first two columns) moved along the ray onto the face's
+  // plane; only their components along the texture's axes count.
   const double inv = 1.0 / safe_component(dir[axis]);
-  ddx -= dir * (ddx[axis] * inv);
-  ddy -= dir * (ddy[axis] * inv);
-  const double fu = std::max(std::abs(ddx[u_axis]), std::abs(ddy[u_axis])) / u_scale;
-  const double fv = std::max(std::abs(ddx[v_axis]), std::abs(ddy[v_axis])) / v_scale;
+  const double kx = sc.rot(axis, 0) * inv, ky = sc.rot(axis, 1) * inv;
+  const double fu = std::max(std::abs(sc.rot(u_axis, 0) - dir[u_axis] * kx),
+                             std::abs(sc.rot(u_axis, 1) - dir[u_axis] * ky));
+  const double fv = std::max(std::abs(sc.rot(v_axis, 0) - dir[v_axis] * kx),
+                             std::abs(sc.rot(v_axis, 1) - dir[v_axis] * ky)) /
+                    v_scale;
   return depth / sc.f * std::max(fu, fv);
 }
 
@@ -213,7 +217,7 @@ void surface_point(const Scene& sc, const Hit& hit, const cv::Vec3d& o, const cv
   const cv::Vec3d p = o + dir * hit.depth;
   s.light = sc.casters.empty() ? 1.0 : lit(sc, p);
   if (hit.surface == Surface::kGround) {
-    s.footprint = footprint(sc, 1, hit.depth, dir, 0, 2, 1.0, kGroundStretchZ);
+    s.footprint = footprint(sc, 1, hit.depth, dir, 0, 2, kGroundStretchZ);
     s.kind = sc.ground_texture;
     s.seed = sc.ground_seed;
     s.u = p[0];
@@ -222,7 +226,7 @@ void surface_point(const Scene& sc, const Hit& hit, const cv::Vec3d& o, const cv
     return;
   }
   if (hit.surface == Surface::kWall) {
-    s.footprint = footprint(sc, 2, hit.depth, dir, 0, 1, 1.0, 1.0);
+    s.footprint = footprint(sc, 2, hit.depth, dir, 0, 1, 1.0);
     s.kind = sc.wall_texture;
     s.seed = sc.wall_seed;
     s.u = p[0];
@@ -237,7 +241,7 @@ void surface_point(const Scene& sc, const Hit& hit, const cv::Vec3d& o, const cv
   static constexpr int kV[3] = {1, 2, 1};
   static constexpr double kFaceShade[3] = {0.8, 1.15, 1.0};
   const int u = kU[hit.axis], v = kV[hit.axis];
-  s.footprint = footprint(sc, hit.axis, hit.depth, dir, u, v, 1.0, 1.0);
+  s.footprint = footprint(sc, hit.axis, hit.depth, dir, u, v, 1.0);
   s.kind = b.texture;
   s.seed = hash_combine(b.seed, static_cast<std::uint32_t>(hit.axis * 2 + hit.side));
   s.u = local[u];
@@ -516,36 +520,6 @@ void apply_effects(const ImageEffects& fx, double t_s, cv::Mat& left, cv::Mat& r
   }
 }
 
-/// The exposure's blur and the sensor noise for one image rendered without noise: the mean of
-/// `gray` sampled at p + flow(p) * share * (1/2 - k / (n - 1)), k = 0..n-1, with flow the
-/// backward flow of one frame and share the exposure over the frame interval, then `noise`.
-void blur_and_add_noise(cv::Mat& gray, const cv::Mat& flow, double share, const cv::Mat& noise) {
-  double longest2 = 0.0;
-  for (int y = 0; y < flow.rows; ++y) {
-    const auto* q = flow.ptr<cv::Vec2f>(y);
-    for (int x = 0; x < flow.cols; ++x)
-      longest2 = std::max(longest2, static_cast<double>(q[x][0] * q[x][0] + q[x][1] * q[x][1]));
-  }
-  const int n = std::clamp(static_cast<int>(std::ceil(std::sqrt(longest2) * share)) + 1, 2, 12);
-  cv::Mat source, sum = cv::Mat::zeros(gray.size(), CV_32FC1), sample;
-  gray.convertTo(source, CV_32FC1);
-  cv::Mat map(gray.size(), CV_32FC2);
-  for (int k = 0; k < n; ++k) {
-    const double c = share * (0.5 - static_cast<double>(k) / (n - 1));
-    for (int y = 0; y < map.rows; ++y) {
-      const auto* q = flow.ptr<cv::Vec2f>(y);
-      auto* m = map.ptr<cv::Vec2f>(y);
-      for (int x = 0; x < map.cols; ++x)
-        m[x] = cv::Vec2f(static_cast<float>(x + c * q[x][0]), static_cast<float>(y + c * q[x][1]));
-    }
-    cv::remap(source, sample, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
-    sum += sample;
-  }
-  sum *= 1.0 / n;
-  if (!noise.empty()) sum += noise;
-  sum.convertTo(gray, CV_8UC1);  // rounds and saturates
-}
-
 }  // namespace
 
 namespace {
@@ -703,8 +677,8 @@ RenderedFrame Renderer::render(int index, TruthMapSet maps) const {
                   h);
   if (blur) {
     const double share = s.effects.exposure_time_s * s.camera.fps;
-    blur_and_add_noise(r.frame.left, left_flow, share, noise[0]);
-    blur_and_add_noise(r.frame.right, right_flow, share, noise[1]);
+    motion_blur(r.frame.left, left_flow, share, noise[0]);
+    motion_blur(r.frame.right, right_flow, share, noise[1]);
   }
 
   if (s.effects.any()) apply_effects(s.effects, r.frame.time_s, r.frame.left, r.frame.right);
