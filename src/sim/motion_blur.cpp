@@ -71,11 +71,6 @@ int SampleVectors(const BlurRow& r, int x) {
   const hn::ScalableTag<double> dd;
   const hn::Rebind<float, decltype(dd)> df;
   const hn::Rebind<std::int32_t, decltype(dd)> di;
-  const hn::Rebind<std::uint32_t, decltype(dd)> du32;
-  const hn::Rebind<std::int64_t, decltype(dd)> di64;
-  const hn::Rebind<std::uint64_t, decltype(dd)> du64;
-  const auto* pairs = reinterpret_cast<const std::uint64_t*>(r.source);
-  const auto stride64 = hn::Set(di64, static_cast<std::int64_t>(r.stride));
   const int lanes = static_cast<int>(hn::Lanes(dd));
   const auto offset = hn::Set(dd, r.offset), row = hn::Set(dd, static_cast<double>(r.y));
   const auto scale = hn::Set(df, static_cast<float>(kTabSize));
@@ -111,15 +106,6 @@ int SampleVectors(const BlurRow& r, int x) {
       t1 = hn::LoadU(df, top + 1);
       b0 = hn::LoadU(df, top + r.stride);
       b1 = hn::LoadU(df, top + r.stride + 1);
-    } else if (hn::AllTrue(di, inside)) {
-      // No neighbour clamped: each row's two neighbours are adjacent, one 8-byte gather.
-      const auto at = hn::PromoteTo(di64, hn::Add(hn::Mul(y0, stride), x0));
-      const auto top = hn::GatherOffset(du64, pairs, hn::ShiftLeft<2>(at));
-      const auto bottom = hn::GatherOffset(du64, pairs, hn::ShiftLeft<2>(hn::Add(at, stride64)));
-      t0 = hn::BitCast(df, hn::TruncateTo(du32, top));
-      t1 = hn::BitCast(df, hn::TruncateTo(du32, hn::ShiftRight<32>(top)));
-      b0 = hn::BitCast(df, hn::TruncateTo(du32, bottom));
-      b1 = hn::BitCast(df, hn::TruncateTo(du32, hn::ShiftRight<32>(bottom)));
     } else {
       const auto xa = hn::Min(hn::Max(x0, zero), last_x);
       const auto xb = hn::Min(hn::Max(hn::Add(x0, one_i), zero), last_x);
